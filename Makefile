@@ -1,0 +1,36 @@
+# The two commands of the README:
+#   make demo   set up, build, run the main job on a built-in default
+#   make test   set up, build, run every test
+# Without set-up (packages already installed): make build, make check, make asan, make tsan.
+BUILD ?= build
+JOBS ?= $(shell nproc)
+CMAKE_FLAGS ?=
+
+.PHONY: setup build demo test check asan tsan bench clean
+
+setup:
+	bash scripts/setup
+
+build:
+	cmake -S . -B $(BUILD) -DCMAKE_BUILD_TYPE=Release $(CMAKE_FLAGS)
+	cmake --build $(BUILD) -j $(JOBS)
+
+demo: setup build
+	./$(BUILD)/apps/hiveslam demo --out demo_out
+
+test: setup check
+
+check: build
+	cd $(BUILD) && ctest --output-on-failure -j $(JOBS)
+
+asan:
+	$(MAKE) check BUILD=build-asan CMAKE_FLAGS="-DHIVESLAM_ASAN=ON -DCMAKE_BUILD_TYPE=RelWithDebInfo -DHIVESLAM_BUILD_BENCH=OFF"
+
+tsan:
+	$(MAKE) check BUILD=build-tsan CMAKE_FLAGS="-DHIVESLAM_TSAN=ON -DCMAKE_BUILD_TYPE=RelWithDebInfo -DHIVESLAM_BUILD_BENCH=OFF"
+
+bench: build
+	./$(BUILD)/bench/render_bench
+
+clean:
+	rm -rf build build-asan build-tsan demo_out

@@ -1,0 +1,31 @@
+// hiveslam: one program for every node and every tool; see `hiveslam --help`.
+#include <spdlog/spdlog.h>
+
+#include <cstdio>
+#include <opencv2/core/utils/logger.hpp>
+
+#include "apps/commands.hpp"
+#include "common/error.hpp"
+
+int main(int argc, char** argv) {
+  cv::utils::logging::setLogLevel(cv::utils::logging::LOG_LEVEL_ERROR);
+  CLI::App app{"hiveslam: self-organizing distributed monocular visual SLAM"};
+  app.require_subcommand(1);
+  app.set_version_flag("--version", "hiveslam 0.1.0");
+  hiveslam::apps::addSynthCommand(app);
+  hiveslam::apps::addEvalCommand(app);
+  hiveslam::apps::addInfoCommand(app);
+  hiveslam::apps::addDemoCommand(app);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e);
+  } catch (const hiveslam::InputError& e) {
+    std::fprintf(stderr, "hiveslam: error: %s\n", e.what());
+    return 1;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "hiveslam: error: %s\n", e.what());
+    return 1;
+  }
+  return 0;
+}

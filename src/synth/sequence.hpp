@@ -1,0 +1,58 @@
+#pragma once
+// A whole synthetic sequence: scene, camera motion, imaging effects, written in the EuRoC ASL
+// layout (mav0/cam0/{data/,data.csv,sensor.yaml}, mav0/state_groundtruth_estimate0/data.csv)
+// with the camera as the body (T_BS = identity) so ground truth is the camera pose.
+#include <cstdint>
+#include <filesystem>
+#include <functional>
+#include <string>
+
+#include "synth/camera_path.hpp"
+#include "synth/lens.hpp"
+#include "synth/scene.hpp"
+#include "synth/trajectory_plan.hpp"
+
+namespace hiveslam::synth {
+
+struct SequenceOptions {
+  std::string trajectory = "loop";
+  uint64_t seed = 1;
+  int frames = 1000;
+  int width = 752, height = 480;
+  double fps = 20.0;
+  std::string textures;          // folder of photos; empty: procedural textures
+  bool distortion = false;       // EuRoC-like radial-tangential lens
+  double noise = 2.0;            // sensor noise sigma, grey levels
+  bool motion_blur = false;      // average of sub-frames over a 10 ms exposure
+  bool exposure_changes = false; // slow gain changes of up to +-25%
+  int threads = 0;               // 0: all cores
+};
+
+// Everything a sequence is made of, rebuilt deterministically from the options.
+struct SequenceModel {
+  SequenceOptions options;
+  Lens lens;
+  Scene scene;
+  CameraPath path;
+  TrajectoryPlan plan;
+
+  double stamp(int frame) const;                   // seconds
+  int64_t stampNs(int frame) const;
+  Eigen::Isometry3d pose(int frame) const;         // T_wc at the frame's stamp
+  bool blank(int frame) const;
+  // The 8-bit image of a frame with every imaging effect applied.
+  cv::Mat renderImage(int frame, const RayTable& rays) const;
+};
+
+SequenceModel buildSequence(const SequenceOptions& options);
+
+struct SequenceSummary {
+  int frames = 0, blank_frames = 0;
+  double path_length = 0.0, duration = 0.0, render_seconds = 0.0;
+};
+
+// Renders every frame (frames in parallel) and writes the dataset under `out`.
+SequenceSummary writeSequence(const SequenceOptions& options, const std::filesystem::path& out,
+                              const std::function<void(int done, int total)>& progress = {});
+
+}  // namespace hiveslam::synth

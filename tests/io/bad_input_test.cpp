@@ -1,0 +1,168 @@
+// Bad input gets one clear error naming the file, never a crash or a half-read sequence.
+#include <gtest/gtest.h>
+
+#include <array>
+#include <cstdio>
+#include <fstream>
+#include <opencv2/imgcodecs.hpp>
+#include <sys/wait.h>
+
+#include "common/error.hpp"
+#include "io/camera_settings.hpp"
+#include "io/image_file.hpp"
+#include "io/open_dataset.hpp"
+#include "synth/sequence.hpp"
+#include "temp_dir.hpp"
+
+namespace hiveslam::io {
+namespace {
+
+namespace fs = std::filesystem;
+
+// Runs f and returns the InputError message (fails the test when nothing is thrown).
+template <typename F>
+std::string errorOf(F&& f) {
+  try {
+    f();
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  ADD_FAILURE() << "no InputError";
+  return "";
+}
+
+fs::path makeSequence(const testing::TempDir& dir) {
+  synth::SequenceOptions o;
+  o.width = 96;
+  o.height = 64;
+  o.frames = 4;
+  synth::writeSequence(o, dir.path());
+  return dir.path();
+}
+
+std::vector<fs::path> frames(const fs::path& root) {
+  std::vector<fs::path> files;
+  for (const auto& e : fs::directory_iterator(root / "mav0/cam0/data")) files.push_back(e.path());
+  std::sort(files.begin(), files.end());
+  return files;
+}
+
+void readAll(const fs::path& root) {
+  auto source = openDataset(root);
+  while (source->next()) {
+  }
+}
+
+TEST(BadInput, MissingFolder) {
+  const std::string msg = errorOf([] { openDataset("/nonexistent/hiveslam/dataset"); });
+  EXPECT_NE(msg.find("/nonexistent/hiveslam/dataset"), std::string::npos) << msg;
+}
+
+TEST(BadInput, UnknownLayout) {
+  testing::TempDir dir;
+  std::ofstream(dir / "readme.md") << "hello\n";
+  EXPECT_NE(errorOf([&] { openDataset(dir.path()); }).find("cannot tell"), std::string::npos);
+}
+
+TEST(BadInput, TruncatedPngNamesTheFile) {
+  testing::TempDir dir;
+  const auto files = frames(makeSequence(dir));
+  fs::resize_file(files[2], fs::file_size(files[2]) / 2);
+  const std::string msg = errorOf([&] { readAll(dir.path()); });
+  EXPECT_NE(msg.find(files[2].filename().string()), std::string::npos) << msg;
+  EXPECT_NE(msg.find("truncated"), std::string::npos) << msg;
+}
+
+TEST(BadInput, CorruptImageNamesTheFile) {
+  testing::TempDir dir;
+  const auto files = frames(makeSequence(dir));
+  std::ofstream(files[1], std::ios::binary) << "this is not an image at all";
+  const std::string msg = errorOf([&] { readAll(dir.path()); });
+  EXPECT_NE(msg.find(files[1].filename().string()), std::string::npos) << msg;
+}
+
+TEST(BadInput, MissingImageNamesTheFile) {
+  testing::TempDir dir;
+  const auto files = frames(makeSequence(dir));
+  fs::remove(files[3]);
+  EXPECT_NE(errorOf([&] { readAll(dir.path()); }).find(files[3].filename().string()), std::string::npos);
+}
+
+TEST(BadInput, TimesOutOfOrderNamesFileAndLine) {
+  testing::TempDir dir;
+  fs::create_directories(dir / "images");
+  for (int i = 0; i < 3; ++i) cv::imwrite((dir / "images" / (std::to_string(i) + ".png")).string(), cv::Mat(8, 8, CV_8U, cv::Scalar(i)));
+  std::ofstream(dir / "times.txt") << "0.0\n0.2\n0.1\n";
+  std::ofstream(dir / "calib.txt") << "width 8\nheight 8\nfx 5\nfy 5\ncx 4\ncy 4\n";
+  const std::string msg = errorOf([&] { openDataset(dir.path()); });
+  EXPECT_NE(msg.find("times.txt:3"), std::string::npos) << msg;
+}
+
+TEST(BadInput, EurocStampsOutOfOrder) {
+  testing::TempDir dir;
+  makeSequence(dir);
+  std::ofstream(dir / "mav0/cam0/data.csv") << "#timestamp [ns],filename\n2000,a.png\n1000,b.png\n";
+  EXPECT_NE(errorOf([&] { openDataset(dir.path()); }).find("data.csv:3"), std::string::npos);
+}
+
+TEST(BadInput, TimesCountDifferentFromImageCount) {
+  testing::TempDir dir;
+  fs::create_directories(dir / "images");
+  cv::imwrite((dir / "images/0.png").string(), cv::Mat(8, 8, CV_8U, cv::Scalar(1)));
+  std::ofstream(dir / "times.txt") << "0.0\n0.1\n";
+  std::ofstream(dir / "calib.txt") << "width 8\nheight 8\nfx 5\nfy 5\ncx 4\ncy 4\n";
+  EXPECT_NE(errorOf([&] { openDataset(dir.path()); }).find("2 timestamps"), std::string::npos);
+}
+
+TEST(BadInput, CalibrationWithWrongSizes) {
+  testing::TempDir dir;
+  auto write = [&](const std::string& camera) {
+    std::ofstream(dir / "s.yaml") << "camera:\n" << camera;
+    return errorOf([&] { loadSettingsCamera(dir / "s.yaml"); });
+  };
+  EXPECT_NE(write("  model: pinhole\n  width: 10\n  height: 10\n  intrinsics: [5, 5, 5]\n").find("4 values"), std::string::npos);
+  EXPECT_NE(write("  model: pinhole\n  width: 10\n  height: 10\n  intrinsics: [5, 5, 5, 5]\n  distortion: [0.1, 0.2, 0.3]\n").find("4 or 5"), std::string::npos);
+  EXPECT_NE(write("  model: kannala-brandt\n  width: 10\n  height: 10\n  intrinsics: [5, 5, 5, 5]\n  distortion: [0.1]\n").find("4 coefficients"), std::string::npos);
+  EXPECT_NE(write("  model: pinhole\n  width: -3\n  height: 10\n  intrinsics: [5, 5, 5, 5]\n").find("not valid"), std::string::npos);
+  EXPECT_NE(write("  model: pinhole\n  width: 10\n  height: 10\n  intrinsics: [-5, 5, 5, 5]\n").find("positive"), std::string::npos);
+  EXPECT_NE(write("  model: pinhole\n  width: 10\n  height: 10\n  intrinsics: [5, 5, 50, 5]\n").find("outside"), std::string::npos);
+  EXPECT_NE(write("  model: orthographic\n  width: 10\n  height: 10\n  intrinsics: [5, 5, 5, 5]\n").find("unknown camera model"), std::string::npos);
+  EXPECT_NE(write("  model: pinhole\n  width: 10\n").find("height"), std::string::npos);
+  EXPECT_NE(write("  model: [pinhole\n").find("s.yaml"), std::string::npos);
+}
+
+TEST(BadInput, ImageSizeDifferentFromCalibration) {
+  testing::TempDir dir;
+  makeSequence(dir);
+  std::ofstream(dir / "wrong.yaml") << "camera:\n  model: pinhole\n  width: 100\n  height: 64\n  intrinsics: [50, 50, 48, 32]\n";
+  const std::string msg = errorOf([&] {
+    auto source = openDataset(dir.path(), {dir / "wrong.yaml", std::nullopt});
+    source->next();
+  });
+  EXPECT_NE(msg.find("96x64 but the calibration says 100x64"), std::string::npos) << msg;
+}
+
+TEST(BadInput, EurocSensorYamlWithWrongResolution) {
+  testing::TempDir dir;
+  makeSequence(dir);
+  std::ofstream(dir / "mav0/cam0/sensor.yaml") << "resolution: [96]\nintrinsics: [50, 50, 48, 32]\n";
+  EXPECT_NE(errorOf([&] { openDataset(dir.path()); }).find("sensor.yaml"), std::string::npos);
+}
+
+// The command line turns every one of these into one line on stderr and a non-zero exit.
+TEST(BadInput, CommandLinePrintsOneLineAndFails) {
+  const std::string cmd = std::string(HIVESLAM_BINARY) + " info /nonexistent/hiveslam/dataset 2>&1";
+  FILE* pipe = popen(cmd.c_str(), "r");
+  ASSERT_NE(pipe, nullptr);
+  std::string out;
+  std::array<char, 256> buf{};
+  while (fgets(buf.data(), buf.size(), pipe)) out += buf.data();
+  const int status = pclose(pipe);
+  EXPECT_TRUE(WIFEXITED(status));
+  EXPECT_NE(WEXITSTATUS(status), 0);
+  EXPECT_EQ(std::count(out.begin(), out.end(), '\n'), 1) << out;
+  EXPECT_NE(out.find("dataset not found: /nonexistent/hiveslam/dataset"), std::string::npos) << out;
+}
+
+}  // namespace
+}  // namespace hiveslam::io

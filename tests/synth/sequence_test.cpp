@@ -1,0 +1,135 @@
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <opencv2/imgproc.hpp>
+
+#include "io/open_dataset.hpp"
+#include "synth/renderer.hpp"
+#include "synth/sequence.hpp"
+#include "synth/suite.hpp"
+#include "temp_dir.hpp"
+
+namespace hiveslam::synth {
+namespace {
+
+// Ground truth consistent with the images: warp frame i into frame j through the rendered depth
+// of i and the poses the dataset reader returns; the true poses make the images agree, a wrong
+// pose does not.
+TEST(Sequence, GroundTruthIsConsistentWithTheImages) {
+  testing::TempDir dir;
+  SequenceOptions o;
+  // Long enough for realistic speeds (the path always spans the whole sequence), small images.
+  o.width = 188;
+  o.height = 120;
+  o.frames = 200;
+  o.seed = 5;
+  o.distortion = true;
+  writeSequence(o, dir.path());
+  auto source = io::openDataset(dir.path());
+  std::vector<cv::Mat> images;
+  while (auto f = source->next()) images.push_back(f->image);
+  const auto& gt = *source->groundTruth();
+  const auto& cam = *source->camera().camera;
+
+  const SequenceModel model = buildSequence(o);
+  const RayTable rays(model.lens);
+  auto warpError = [&](int i, int j, const Eigen::Isometry3d& T_wj) {
+    cv::Mat radiance, depth;
+    renderRadiance(model.scene, rays, gt.poses[static_cast<size_t>(i)], radiance, &depth);
+    const Eigen::Isometry3d T_ji = T_wj.inverse() * gt.poses[static_cast<size_t>(i)];
+    double sum = 0;
+    int n = 0;
+    for (int v = 5; v < o.height - 5; ++v)
+      for (int u = 5; u < o.width - 5; ++u) {
+        const Eigen::Vector3d bearing = cam.unproject(Eigen::Vector2d(u, v));
+        const Eigen::Vector3d p_i = bearing * depth.at<float>(v, u) / bearing.z();
+        Eigen::Vector2d uv;
+        if (!cam.project(T_ji * p_i, uv) || !cam.inImage(uv, 2)) continue;
+        cv::Mat patch;
+        cv::getRectSubPix(images[static_cast<size_t>(j)], {1, 1}, cv::Point2f(uv.x(), uv.y()), patch, CV_32F);
+        sum += std::abs(patch.at<float>(0, 0) - images[static_cast<size_t>(i)].at<uchar>(v, u));
+        ++n;
+      }
+    EXPECT_GT(n, 1000);
+    return sum / n;
+  };
+  const double right = warpError(100, 104, gt.poses[104]);
+  const double wrong = warpError(100, 104, gt.poses[108]);
+  EXPECT_LT(right, 8.0);  // noise (2 grey levels per image), interpolation and occlusions
+  EXPECT_GT(wrong, 2.5 * right);
+}
+
+TEST(Sequence, DeterministicPerSeed) {
+  SequenceOptions o;
+  o.width = 96;
+  o.height = 64;
+  o.frames = 10;
+  const SequenceModel a = buildSequence(o), b = buildSequence(o);
+  const RayTable rays(a.lens);
+  EXPECT_EQ(cv::norm(a.renderImage(4, rays), b.renderImage(4, rays), cv::NORM_INF), 0.0);
+  o.seed = 2;
+  const SequenceModel c = buildSequence(o);
+  EXPECT_GT(cv::norm(a.renderImage(4, rays), c.renderImage(4, rays), cv::NORM_L1), 1000.0);
+  EXPECT_GT((a.pose(5).translation() - c.pose(5).translation()).norm(), 1e-3);
+}
+
+// Motions a hand-held camera makes: bounded speeds, never through an obstacle.
+class SuiteMotion : public ::testing::TestWithParam<std::string> {};
+
+TEST_P(SuiteMotion, RealisticAndCollisionFree) {
+  for (const auto& entry : suite("standard")) {
+    if (entry.name != GetParam()) continue;
+    const SequenceModel m = buildSequence(entry.options);
+    const double dt = 1.0 / entry.options.fps;
+    double max_speed = 0, max_turn = 0;
+    int blank = 0;
+    for (int f = 0; f < entry.options.frames; ++f) {
+      const auto T = m.pose(f);
+      EXPECT_TRUE(m.scene.isFree(T.translation(), 0.4)) << entry.name << " frame " << f;
+      if (m.blank(f)) ++blank;
+      if (f == 0) continue;
+      const auto P = m.pose(f - 1);
+      max_speed = std::max(max_speed, (T.translation() - P.translation()).norm() / dt);
+      max_turn = std::max(max_turn, Eigen::AngleAxisd(P.linear().transpose() * T.linear()).angle() / dt);
+    }
+    EXPECT_LT(max_speed, 1.6) << entry.name;             // m/s, brisk walking at most
+    EXPECT_LT(max_turn, 80.0 * M_PI / 180.0) << entry.name;  // rad/s
+    const double blank_share = static_cast<double>(blank) / entry.options.frames;
+    if (entry.name == "blackout") {
+      EXPECT_GT(blank_share, 0.03);
+      EXPECT_LT(blank_share, 0.08);
+    } else {
+      EXPECT_EQ(blank, 0) << entry.name;
+    }
+    if (entry.name == "loop" || entry.name == "figure8") {
+      // A place seen at the start is seen again later from nearly the same pose.
+      const auto start = m.pose(static_cast<int>(0.03 * entry.options.frames));
+      double best = 1e9;
+      for (int f = entry.options.frames / 2; f < entry.options.frames; ++f) {
+        const auto T = m.pose(f);
+        const double angle = Eigen::AngleAxisd(start.linear().transpose() * T.linear()).angle();
+        if (angle < 0.35) best = std::min(best, (T.translation() - start.translation()).norm());
+      }
+      EXPECT_LT(best, 0.5) << entry.name;
+    }
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(Standard, SuiteMotion, ::testing::Values("loop", "figure8", "blackout", "sweep"));
+
+TEST(Sequence, WritesEurocLayout) {
+  testing::TempDir dir;
+  SequenceOptions o;
+  o.width = 64;
+  o.height = 48;
+  o.frames = 3;
+  o.trajectory = "sweep";
+  const auto s = writeSequence(o, dir.path());
+  EXPECT_EQ(s.frames, 3);
+  for (const char* f : {"mav0/cam0/data.csv", "mav0/cam0/sensor.yaml", "mav0/state_groundtruth_estimate0/data.csv",
+                        "sequence.json", "mav0/cam0/data/1000000000000.png", "mav0/cam0/data/1000050000000.png"})
+    EXPECT_TRUE(std::filesystem::exists(dir / f)) << f;
+}
+
+}  // namespace
+}  // namespace hiveslam::synth
