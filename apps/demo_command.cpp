@@ -57,7 +57,7 @@ void addDemoCommand(CLI::App& app) {
 
     fmt::print("\n{:<34} {}\n", "sequence", seq.string());
     fmt::print("{:<34} {}\n", "dataset", source->describe());
-    fmt::print("{:<34} {} ({} blank)\n", "frames rendered / read back", summary.frames, summary.blank_frames);
+    fmt::print("{:<34} {} ({} blank)\n", "frames rendered", summary.frames, summary.blank_frames);
     fmt::print("{:<34} {}\n", "frames read back", frames);
     fmt::print("{:<34} {:.2f} m in {:.1f} s\n", "camera path", summary.path_length, summary.duration);
     fmt::print("{:<34} {:.1f} s ({:.1f} frames/s)\n", "render time", summary.render_seconds,
