@@ -1,0 +1,189 @@
+#include "core/features/orb_extractor.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <opencv2/features2d.hpp>
+#include <opencv2/imgproc.hpp>
+#include <queue>
+
+#include "core/features/brief_pattern.hpp"
+
+namespace hiveslam::features {
+
+namespace {
+
+constexpr int kHalfPatch = 15;  // orientation patch radius
+constexpr int kBorder = 19;     // pad so rotated BRIEF pairs and patches stay inside
+
+// Keeps the strongest keypoint of each quadtree leaf, splitting the most populated leaf until
+// there are `target` leaves or no leaf holds more than one keypoint.
+std::vector<cv::KeyPoint> distribute(const std::vector<cv::KeyPoint>& kps, const cv::Rect2f& area, int target) {
+  if (kps.empty() || target <= 0) return {};
+  struct Node {
+    cv::Rect2f rect;
+    std::vector<int> idx;
+  };
+  auto cmp = [](const Node& a, const Node& b) { return a.idx.size() < b.idx.size(); };
+  std::priority_queue<Node, std::vector<Node>, decltype(cmp)> open(cmp);
+  std::vector<Node> done;  // leaves with a single keypoint
+  // Roughly square initial nodes across the image width.
+  const int roots = std::max(1, static_cast<int>(std::lround(area.width / area.height)));
+  const float w = area.width / roots;
+  std::vector<Node> initial(static_cast<size_t>(roots));
+  for (int i = 0; i < roots; ++i) initial[static_cast<size_t>(i)].rect = {area.x + i * w, area.y, w, area.height};
+  for (int k = 0; k < static_cast<int>(kps.size()); ++k) {
+    const int i = std::clamp(static_cast<int>((kps[static_cast<size_t>(k)].pt.x - area.x) / w), 0, roots - 1);
+    initial[static_cast<size_t>(i)].idx.push_back(k);
+  }
+  for (auto& n : initial) {
+    if (n.idx.size() == 1) done.push_back(std::move(n));
+    else if (!n.idx.empty()) open.push(std::move(n));
+  }
+  while (!open.empty() && static_cast<int>(open.size() + done.size()) < target) {
+    Node n = open.top();
+    open.pop();
+    const float hw = n.rect.width / 2, hh = n.rect.height / 2;
+    if (hw < 1.0f && hh < 1.0f) {  // cannot split further: points on one pixel
+      done.push_back(std::move(n));
+      continue;
+    }
+    Node child[4];
+    for (int c = 0; c < 4; ++c) child[c].rect = {n.rect.x + (c % 2) * hw, n.rect.y + (c / 2) * hh, hw, hh};
+    for (int k : n.idx) {
+      const auto& p = kps[static_cast<size_t>(k)].pt;
+      const int c = (p.x >= n.rect.x + hw ? 1 : 0) + (p.y >= n.rect.y + hh ? 2 : 0);
+      child[c].idx.push_back(k);
+    }
+    for (auto& c : child) {
+      if (c.idx.size() == 1) done.push_back(std::move(c));
+      else if (!c.idx.empty()) open.push(std::move(c));
+    }
+  }
+  while (!open.empty()) {
+    done.push_back(open.top());
+    open.pop();
+  }
+  std::vector<cv::KeyPoint> out;
+  for (const auto& n : done) {
+    int best = n.idx.front();
+    for (int k : n.idx)
+      if (kps[static_cast<size_t>(k)].response > kps[static_cast<size_t>(best)].response) best = k;
+    out.push_back(kps[static_cast<size_t>(best)]);
+  }
+  if (static_cast<int>(out.size()) > target) {
+    std::nth_element(out.begin(), out.begin() + target, out.end(),
+                     [](const cv::KeyPoint& a, const cv::KeyPoint& b) { return a.response > b.response; });
+    out.resize(static_cast<size_t>(target));
+  }
+  return out;
+}
+
+// Orientation by the intensity centroid of a disc of radius kHalfPatch, in degrees.
+float orientation(const cv::Mat& img, cv::Point2f pt) {
+  const int cx = cvRound(pt.x), cy = cvRound(pt.y);
+  double m01 = 0, m10 = 0;
+  for (int dy = -kHalfPatch; dy <= kHalfPatch; ++dy) {
+    const uchar* row = img.ptr<uchar>(cy + dy);
+    const int span = static_cast<int>(std::sqrt(kHalfPatch * kHalfPatch - dy * dy + 0.5));
+    for (int dx = -span; dx <= span; ++dx) {
+      const double v = row[cx + dx];
+      m10 += dx * v;
+      m01 += dy * v;
+    }
+  }
+  float a = static_cast<float>(std::atan2(m01, m10) * 180.0 / CV_PI);
+  return a < 0 ? a + 360.0f : a;
+}
+
+void describe(const cv::Mat& smooth, const cv::KeyPoint& kp, cv::Point2f at, uchar* out) {
+  const auto& pattern = briefPattern();
+  const float a = kp.angle * static_cast<float>(CV_PI / 180.0);
+  const float c = std::cos(a), s = std::sin(a);
+  const int cx = cvRound(at.x), cy = cvRound(at.y);
+  auto value = [&](int x, int y) {
+    const int rx = cvRound(c * x - s * y), ry = cvRound(s * x + c * y);
+    return smooth.at<uchar>(cy + ry, cx + rx);
+  };
+  for (int byte = 0; byte < 32; ++byte) {
+    uchar v = 0;
+    for (int bit = 0; bit < 8; ++bit) {
+      const auto& p = pattern[static_cast<size_t>(byte * 8 + bit)];
+      if (value(p[0], p[1]) < value(p[2], p[3])) v |= static_cast<uchar>(1u << bit);
+    }
+    out[byte] = v;
+  }
+}
+
+}  // namespace
+
+OrbExtractor::OrbExtractor(const OrbOptions& o) : options_(o) {
+  scales_.resize(static_cast<size_t>(o.levels));
+  scales_[0] = 1.0;
+  for (int i = 1; i < o.levels; ++i) scales_[static_cast<size_t>(i)] = scales_[static_cast<size_t>(i - 1)] * o.scale_factor;
+  // Features per level in proportion to the level's linear size (a geometric series).
+  const double f = 1.0 / o.scale_factor;
+  double n = o.features * (1 - f) / (1 - std::pow(f, o.levels));
+  int sum = 0;
+  for (int i = 0; i < o.levels - 1; ++i) {
+    per_level_.push_back(static_cast<int>(std::lround(n)));
+    sum += per_level_.back();
+    n *= f;
+  }
+  per_level_.push_back(std::max(o.features - sum, 0));
+}
+
+void OrbExtractor::extract(const cv::Mat& gray, std::vector<cv::KeyPoint>& keypoints, cv::Mat& descriptors) const {
+  CV_Assert(gray.type() == CV_8UC1);
+  keypoints.clear();
+  std::vector<cv::Mat> descs;
+  cv::Mat level_img = gray;
+  for (int level = 0; level < options_.levels; ++level) {
+    const double s = scales_[static_cast<size_t>(level)];
+    if (level > 0) {
+      const cv::Size size(cvRound(gray.cols / s), cvRound(gray.rows / s));
+      if (size.width < 2 * kBorder || size.height < 2 * kBorder) break;
+      cv::resize(gray, level_img, size, 0, 0, cv::INTER_LINEAR);
+    }
+    cv::Mat padded;
+    cv::copyMakeBorder(level_img, padded, kBorder, kBorder, kBorder, kBorder, cv::BORDER_REFLECT_101);
+    // FAST per cell over the image (3 px margin for the FAST circle), adaptive threshold.
+    std::vector<cv::KeyPoint> found;
+    const int W = level_img.cols, H = level_img.rows, cs = options_.cell_size;
+    for (int y0 = 0; y0 < H; y0 += cs)
+      for (int x0 = 0; x0 < W; x0 += cs) {
+        const cv::Rect cell(x0 + kBorder - 3, y0 + kBorder - 3, std::min(cs, W - x0) + 6, std::min(cs, H - y0) + 6);
+        const cv::Mat roi = padded(cell);
+        std::vector<cv::KeyPoint> k;
+        cv::FAST(roi, k, options_.fast_threshold, true);
+        if (k.empty()) cv::FAST(roi, k, options_.min_fast_threshold, true);
+        for (auto& kp : k) {
+          kp.pt.x += static_cast<float>(x0 - 3);
+          kp.pt.y += static_cast<float>(y0 - 3);
+          if (kp.pt.x < 0 || kp.pt.y < 0 || kp.pt.x > W - 1 || kp.pt.y > H - 1) continue;
+          found.push_back(kp);
+        }
+      }
+    std::vector<cv::KeyPoint> kept = distribute(found, cv::Rect2f(0, 0, static_cast<float>(W), static_cast<float>(H)),
+                                                per_level_[static_cast<size_t>(level)]);
+    cv::Mat smooth;
+    cv::GaussianBlur(padded, smooth, cv::Size(7, 7), 2, 2, cv::BORDER_REFLECT_101);
+    cv::Mat level_desc(static_cast<int>(kept.size()), 32, CV_8U);
+    for (size_t i = 0; i < kept.size(); ++i) {
+      cv::KeyPoint& kp = kept[i];
+      const cv::Point2f at(kp.pt.x + kBorder, kp.pt.y + kBorder);
+      kp.angle = orientation(padded, at);
+      describe(smooth, kp, at, level_desc.ptr<uchar>(static_cast<int>(i)));
+      kp.octave = level;
+      kp.size = static_cast<float>(31.0 * s);
+      // resize maps pixel centres: level pixel x sits at (x + 0.5) s - 0.5 on level 0.
+      kp.pt.x = static_cast<float>((kp.pt.x + 0.5) * s - 0.5);
+      kp.pt.y = static_cast<float>((kp.pt.y + 0.5) * s - 0.5);
+      keypoints.push_back(kp);
+    }
+    if (!kept.empty()) descs.push_back(level_desc);
+  }
+  if (descs.empty()) descriptors.release();
+  else cv::vconcat(descs, descriptors);
+}
+
+}  // namespace hiveslam::features

@@ -1,0 +1,114 @@
+#include "core/optim/bundle_adjustment.hpp"
+
+#include <ceres/ceres.h>
+#include <ceres/rotation.h>
+
+namespace hiveslam::core {
+
+namespace {
+
+struct ReprojectionError {
+  ReprojectionError(const Intrinsics& K, const Eigen::Vector2d& uv, double w) : K(K), uv(uv), w(w) {}
+
+  template <typename T>
+  bool operator()(const T* q, const T* t, const T* p, T* r) const {
+    // Ceres' quaternion order is (w, x, y, z); Eigen stores (x, y, z, w): convert.
+    const T qw[4] = {q[3], q[0], q[1], q[2]};
+    T pc[3];
+    ceres::QuaternionRotatePoint(qw, p, pc);
+    pc[0] += t[0];
+    pc[1] += t[1];
+    pc[2] += t[2];
+    if (pc[2] <= T(1e-6)) pc[2] = T(1e-6);  // keeps the cost finite; such points are outliers
+    r[0] = (T(K.fx) * pc[0] / pc[2] + T(K.cx) - T(uv.x())) * T(w);
+    r[1] = (T(K.fy) * pc[1] / pc[2] + T(K.cy) - T(uv.y())) * T(w);
+    return true;
+  }
+
+  Intrinsics K;
+  Eigen::Vector2d uv;
+  double w;
+};
+
+class AbortCallback : public ceres::IterationCallback {
+ public:
+  explicit AbortCallback(const std::atomic<bool>* flag) : flag_(flag) {}
+  ceres::CallbackReturnType operator()(const ceres::IterationSummary&) override {
+    return flag_ && flag_->load() ? ceres::SOLVER_TERMINATE_SUCCESSFULLY : ceres::SOLVER_CONTINUE;
+  }
+
+ private:
+  const std::atomic<bool>* flag_;
+};
+
+}  // namespace
+
+BaSummary bundleAdjust(BaProblem& pb, const BaOptions& o) {
+  ceres::Problem::Options problem_options;
+  problem_options.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+  ceres::Problem problem(problem_options);
+  ceres::EigenQuaternionManifold quaternion;  // outlives the problem, which does not own it
+  std::vector<ceres::ResidualBlockId> blocks;
+  for (const auto& ob : pb.observations) {
+    auto& pose = pb.poses[static_cast<size_t>(ob.pose)];
+    auto& point = pb.points[static_cast<size_t>(ob.point)];
+    auto* cost = new ceres::AutoDiffCostFunction<ReprojectionError, 2, 4, 3, 3>(
+        new ReprojectionError(pb.K, ob.uv, ob.inv_sigma));
+    blocks.push_back(problem.AddResidualBlock(cost, new ceres::HuberLoss(o.huber_px), pose.q_cw.coeffs().data(),
+                                              pose.t_cw.data(), point.p_w.data()));
+  }
+  for (auto& pose : pb.poses) {
+    if (!problem.HasParameterBlock(pose.q_cw.coeffs().data())) continue;
+    problem.SetManifold(pose.q_cw.coeffs().data(), &quaternion);
+    if (pose.fixed) {
+      problem.SetParameterBlockConstant(pose.q_cw.coeffs().data());
+      problem.SetParameterBlockConstant(pose.t_cw.data());
+    }
+  }
+  for (auto& point : pb.points)
+    if (point.fixed && problem.HasParameterBlock(point.p_w.data())) problem.SetParameterBlockConstant(point.p_w.data());
+
+  ceres::Solver::Options options;
+  options.linear_solver_type = ceres::SPARSE_SCHUR;
+  options.max_num_iterations = o.iterations;
+  options.num_threads = 1;
+  options.logging_type = ceres::SILENT;
+  AbortCallback abort(o.abort);
+  options.callbacks.push_back(&abort);
+  ceres::Solver::Summary summary;
+  ceres::Solve(options, &problem, &summary);
+
+  BaSummary out;
+  out.initial_cost = summary.initial_cost;
+  out.iterations = static_cast<int>(summary.iterations.size());
+  auto classify = [&]() {
+    out.outlier.assign(pb.observations.size(), false);
+    for (size_t i = 0; i < pb.observations.size(); ++i) {
+      const auto& ob = pb.observations[i];
+      const auto& pose = pb.poses[static_cast<size_t>(ob.pose)];
+      const Eigen::Vector3d pc = pose.q_cw * pb.points[static_cast<size_t>(ob.point)].p_w + pose.t_cw;
+      const double chi2 = pc.z() <= 0 ? 1e9 : ((pb.K.project(pc) - ob.uv) * ob.inv_sigma).squaredNorm();
+      out.outlier[i] = chi2 > 5.991;
+    }
+  };
+  classify();
+  // Second round without the outliers: even under a robust kernel they pull the solution.
+  const bool aborted = o.abort && o.abort->load();
+  int removed = 0;
+  for (size_t i = 0; i < blocks.size() && !aborted && o.outlier_round; ++i)
+    if (out.outlier[i] && problem.NumResidualBlocks() > 1) {
+      problem.RemoveResidualBlock(blocks[i]);
+      ++removed;
+    }
+  if (removed > 0) {
+    options.max_num_iterations = std::max(o.iterations / 2, 5);
+    ceres::Solve(options, &problem, &summary);
+    out.iterations += static_cast<int>(summary.iterations.size());
+    classify();
+  }
+  out.converged = summary.termination_type == ceres::CONVERGENCE;
+  out.final_cost = summary.final_cost;
+  return out;
+}
+
+}  // namespace hiveslam::core

@@ -1,0 +1,54 @@
+#pragma once
+// Bundle adjustment over keyframe poses (T_cw) and points (world), on the undistorted ideal
+// pinhole image, with a Huber kernel and per-observation weights from the pyramid level. The
+// same problem serves the initial full BA, local BA (border keyframes fixed) and global BA.
+#include <Eigen/Geometry>
+#include <atomic>
+#include <vector>
+
+#include "core/frame/frame.hpp"
+
+namespace hiveslam::core {
+
+struct BaPose {
+  Eigen::Quaterniond q_cw = Eigen::Quaterniond::Identity();
+  Eigen::Vector3d t_cw = Eigen::Vector3d::Zero();
+  bool fixed = false;
+};
+
+struct BaPoint {
+  Eigen::Vector3d p_w = Eigen::Vector3d::Zero();
+  bool fixed = false;
+};
+
+struct BaObservation {
+  int pose = 0;
+  int point = 0;
+  Eigen::Vector2d uv;       // undistorted pixel
+  double inv_sigma = 1.0;   // 1 / (scale of the keypoint's pyramid level)
+};
+
+struct BaProblem {
+  Intrinsics K;
+  std::vector<BaPose> poses;
+  std::vector<BaPoint> points;
+  std::vector<BaObservation> observations;
+};
+
+struct BaOptions {
+  int iterations = 20;
+  double huber_px = 2.447;                 // sqrt(5.991): the 95% chi-square bound, 2 dof
+  const std::atomic<bool>* abort = nullptr;  // checked between iterations (a new keyframe came)
+  bool outlier_round = true;  // optimize again without the observations the first round rejects
+};
+
+struct BaSummary {
+  bool converged = false;
+  int iterations = 0;
+  double initial_cost = 0, final_cost = 0;
+  std::vector<bool> outlier;  // per observation: chi-square above 5.991 after optimizing
+};
+
+BaSummary bundleAdjust(BaProblem& problem, const BaOptions& options = {});
+
+}  // namespace hiveslam::core

@@ -1,0 +1,109 @@
+#include <gtest/gtest.h>
+
+#include <opencv2/imgproc.hpp>
+
+#include "core/features/hamming.hpp"
+#include "core/features/orb_extractor.hpp"
+#include "synth/sequence.hpp"
+
+namespace hiveslam::features {
+namespace {
+
+cv::Mat renderedImage() {
+  synth::SequenceOptions o;
+  o.frames = 400;
+  const auto model = synth::buildSequence(o);
+  return model.renderImage(150, synth::RayTable(model.lens));
+}
+
+TEST(OrbExtractor, FindsTheRequestedNumberSpreadOverTheImage) {
+  const cv::Mat img = renderedImage();
+  OrbExtractor orb;
+  std::vector<cv::KeyPoint> kps;
+  cv::Mat desc;
+  orb.extract(img, kps, desc);
+  EXPECT_GE(kps.size(), 900u);
+  EXPECT_LE(kps.size(), 1000u);
+  EXPECT_EQ(desc.rows, static_cast<int>(kps.size()));
+  EXPECT_EQ(desc.cols, 32);
+  // Every cell of a 4x4 grid over the image holds features: the quadtree spreads them.
+  int cells[16] = {};
+  for (const auto& k : kps) {
+    ASSERT_GE(k.pt.x, 0);
+    ASSERT_LT(k.pt.x, img.cols);
+    ++cells[std::min(3, static_cast<int>(k.pt.y * 4 / img.rows)) * 4 + std::min(3, static_cast<int>(k.pt.x * 4 / img.cols))];
+  }
+  for (int c : cells) EXPECT_GT(c, 20);
+  // Several pyramid levels take part.
+  std::set<int> octaves;
+  for (const auto& k : kps) octaves.insert(k.octave);
+  EXPECT_GE(octaves.size(), 6u);
+}
+
+// Rotating the image must rotate keypoint angles by the same amount and keep descriptors
+// close enough to match: the "r" of rBRIEF.
+TEST(OrbExtractor, DescriptorsAndAnglesFollowImageRotation) {
+  const cv::Mat img = renderedImage();
+  const double angle = 30.0;
+  const cv::Point2f centre(img.cols / 2.0f, img.rows / 2.0f);
+  const cv::Mat M = cv::getRotationMatrix2D(centre, angle, 1.0);
+  cv::Mat rotated;
+  cv::warpAffine(img, rotated, M, img.size(), cv::INTER_LINEAR, cv::BORDER_CONSTANT, cv::Scalar(0));
+  OrbExtractor orb;
+  std::vector<cv::KeyPoint> k1, k2;
+  cv::Mat d1, d2;
+  orb.extract(img, k1, d1);
+  orb.extract(rotated, k2, d2);
+  int tested = 0, correct = 0, angle_ok = 0;
+  for (size_t i = 0; i < k1.size(); ++i) {
+    const cv::Point2f p = k1[i].pt;
+    const cv::Point2f q(static_cast<float>(M.at<double>(0, 0) * p.x + M.at<double>(0, 1) * p.y + M.at<double>(0, 2)),
+                        static_cast<float>(M.at<double>(1, 0) * p.x + M.at<double>(1, 1) * p.y + M.at<double>(1, 2)));
+    if (cv::norm(q - centre) > 180) continue;  // stay clear of the black corners
+    ++tested;
+    int best = 1 << 30;
+    size_t best_j = 0;
+    for (size_t j = 0; j < k2.size(); ++j) {
+      const int d = hamming(d1.ptr<uchar>(static_cast<int>(i)), d2.ptr<uchar>(static_cast<int>(j)));
+      if (d < best) {
+        best = d;
+        best_j = j;
+      }
+    }
+    if (cv::norm(k2[best_j].pt - q) < 3.0 * orb.scale(k1[i].octave)) {
+      ++correct;
+      // OpenCV's rotation is counter-clockwise in the image, which lowers our angles.
+      double da = std::fmod(k1[i].angle - k2[best_j].angle + 720.0, 360.0);
+      if (std::abs(da - angle) < 10.0) ++angle_ok;
+    }
+  }
+  ASSERT_GT(tested, 200);
+  EXPECT_GT(static_cast<double>(correct) / tested, 0.45) << correct << "/" << tested;
+  EXPECT_GT(static_cast<double>(angle_ok) / std::max(correct, 1), 0.85);
+}
+
+TEST(OrbExtractor, DeterministicAndCheapOnBlankImages) {
+  const cv::Mat img = renderedImage();
+  OrbExtractor orb;
+  std::vector<cv::KeyPoint> a, b;
+  cv::Mat da, db;
+  orb.extract(img, a, da);
+  orb.extract(img, b, db);
+  ASSERT_EQ(a.size(), b.size());
+  EXPECT_EQ(cv::norm(da, db, cv::NORM_HAMMING), 0.0);
+  std::vector<cv::KeyPoint> none;
+  cv::Mat nd;
+  orb.extract(cv::Mat(480, 752, CV_8U, cv::Scalar(0)), none, nd);
+  EXPECT_TRUE(none.empty());
+}
+
+TEST(Hamming, CountsDifferingBits) {
+  unsigned char a[32] = {}, b[32] = {};
+  b[0] = 0xff;
+  b[31] = 0x01;
+  EXPECT_EQ(hamming(a, b), 9);
+  EXPECT_EQ(hamming(a, a), 0);
+}
+
+}  // namespace
+}  // namespace hiveslam::features
