@@ -9,5 +9,6 @@ void addSynthCommand(CLI::App& app);
 void addEvalCommand(CLI::App& app);
 void addInfoCommand(CLI::App& app);
 void addDemoCommand(CLI::App& app);
+void addRunCommand(CLI::App& app);
 
 }  // namespace hiveslam::apps

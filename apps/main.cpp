@@ -16,6 +16,7 @@ int main(int argc, char** argv) {
   hiveslam::apps::addEvalCommand(app);
   hiveslam::apps::addInfoCommand(app);
   hiveslam::apps::addDemoCommand(app);
+  hiveslam::apps::addRunCommand(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -10,6 +10,8 @@ Frame makeFrame(const cv::Mat& gray, size_t index, double timestamp, const featu
   f.index = index;
   f.timestamp = timestamp;
   f.K = {camera.fx(), camera.fy(), camera.cx(), camera.cy()};
+  f.width = camera.width();
+  f.height = camera.height();
   extractor.extract(gray, f.keypoints, f.descriptors);
   f.points.reserve(f.keypoints.size());
   double min_x = 0, min_y = 0, max_x = camera.width(), max_y = camera.height();

@@ -29,6 +29,9 @@ struct Frame {
   cv::Mat descriptors;                   // one 32-byte row per keypoint
   FeatureGrid grid;
   Intrinsics K;
+  int width = 0, height = 0;
+
+  bool inImage(const Eigen::Vector2d& uv) const { return uv.x() >= 0 && uv.y() >= 0 && uv.x() < width && uv.y() < height; }
 
   size_t size() const { return keypoints.size(); }
   std::vector<int> inRadius(double x, double y, double r) const { return grid.inRadius(points, x, y, r); }

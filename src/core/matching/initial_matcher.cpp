@@ -7,13 +7,14 @@
 
 namespace hiveslam::core {
 
-std::vector<int> matchForInitialization(const Frame& f1, const Frame& f2, const InitialMatchOptions& o) {
+std::vector<int> matchForInitialization(const Frame& f1, const Frame& f2, const InitialMatchOptions& o,
+                                        const std::vector<Eigen::Vector2d>* around) {
   std::vector<int> match12(f1.size(), -1);
   std::vector<int> match21(f2.size(), -1);
   std::vector<int> dist21(f2.size(), std::numeric_limits<int>::max());
   for (size_t i = 0; i < f1.size(); ++i) {
     const auto& kp = f1.keypoints[i];
-    const auto& p = f1.points[i];
+    const auto& p = around ? (*around)[i] : f1.points[i];
     int best = std::numeric_limits<int>::max(), second = best, best_j = -1;
     for (int j : f2.inRadius(p.x(), p.y(), o.radius)) {
       if (f2.keypoints[static_cast<size_t>(j)].octave != kp.octave) continue;

@@ -14,7 +14,9 @@ struct InitialMatchOptions {
   bool check_rotation = true;
 };
 
-// For each keypoint of f1, the index of its match in f2 or -1. One-to-one.
-std::vector<int> matchForInitialization(const Frame& f1, const Frame& f2, const InitialMatchOptions& options = {});
+// For each keypoint of f1, the index of its match in f2 or -1. One-to-one. `around`, when
+// given, holds per keypoint of f1 where to search in f2 (where it was last seen).
+std::vector<int> matchForInitialization(const Frame& f1, const Frame& f2, const InitialMatchOptions& options = {},
+                                        const std::vector<Eigen::Vector2d>* around = nullptr);
 
 }  // namespace hiveslam::core

@@ -1,34 +1,11 @@
 #include "core/optim/bundle_adjustment.hpp"
 
 #include <ceres/ceres.h>
-#include <ceres/rotation.h>
+#include "core/optim/reprojection_error.hpp"
 
 namespace hiveslam::core {
 
 namespace {
-
-struct ReprojectionError {
-  ReprojectionError(const Intrinsics& K, const Eigen::Vector2d& uv, double w) : K(K), uv(uv), w(w) {}
-
-  template <typename T>
-  bool operator()(const T* q, const T* t, const T* p, T* r) const {
-    // Ceres' quaternion order is (w, x, y, z); Eigen stores (x, y, z, w): convert.
-    const T qw[4] = {q[3], q[0], q[1], q[2]};
-    T pc[3];
-    ceres::QuaternionRotatePoint(qw, p, pc);
-    pc[0] += t[0];
-    pc[1] += t[1];
-    pc[2] += t[2];
-    if (pc[2] <= T(1e-6)) pc[2] = T(1e-6);  // keeps the cost finite; such points are outliers
-    r[0] = (T(K.fx) * pc[0] / pc[2] + T(K.cx) - T(uv.x())) * T(w);
-    r[1] = (T(K.fy) * pc[1] / pc[2] + T(K.cy) - T(uv.y())) * T(w);
-    return true;
-  }
-
-  Intrinsics K;
-  Eigen::Vector2d uv;
-  double w;
-};
 
 class AbortCallback : public ceres::IterationCallback {
  public:

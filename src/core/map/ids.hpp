@@ -1,0 +1,23 @@
+#pragma once
+// Keyframe and map point identifiers: unique across nodes without coordination, because the
+// creating node's id sits in the high 16 bits and a per-node counter in the low 48.
+#include <atomic>
+#include <cstdint>
+
+namespace hiveslam::core {
+
+using Id = uint64_t;
+constexpr Id kNoId = ~Id{0};
+
+class IdGenerator {
+ public:
+  explicit IdGenerator(uint16_t node = 0) : node_(node) {}
+  Id next() { return (Id{node_} << 48) | counter_.fetch_add(1, std::memory_order_relaxed); }
+  static uint16_t node(Id id) { return static_cast<uint16_t>(id >> 48); }
+
+ private:
+  uint16_t node_;
+  std::atomic<uint64_t> counter_{0};
+};
+
+}  // namespace hiveslam::core

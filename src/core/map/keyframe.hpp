@@ -1,0 +1,41 @@
+#pragma once
+// A keyframe: a frame kept in the map with its pose, its map point matches (one slot per
+// keypoint), covisibility weights (shared map points with other keyframes) and its spanning
+// tree parent. Guarded by its map's mutex (see map.hpp).
+#include <Eigen/Geometry>
+#include <map>
+#include <memory>
+#include <set>
+#include <vector>
+
+#include "core/frame/frame.hpp"
+#include "core/map/ids.hpp"
+
+namespace hiveslam::core {
+
+class MapPoint;
+
+class KeyFrame : public std::enable_shared_from_this<KeyFrame> {
+ public:
+  KeyFrame(Id id, Frame frame, const Eigen::Isometry3d& T_cw)
+      : id(id), frame(std::move(frame)), T_cw(T_cw), points(this->frame.size()) {}
+
+  const Id id;
+  const Frame frame;
+  Eigen::Isometry3d T_cw;
+  std::vector<std::shared_ptr<MapPoint>> points;  // per keypoint, null when unmatched
+  std::map<KeyFrame*, int> covisibility;          // keyframe -> shared points (>= 15 kept)
+  KeyFrame* parent = nullptr;
+  std::set<KeyFrame*> children;
+  bool bad = false;
+
+  Eigen::Vector3d center() const { return T_cw.inverse().translation(); }
+  // Keyframes sharing the most points, best first.
+  std::vector<KeyFrame*> bestCovisible(size_t n) const;
+  // Rebuilds covisibility from the map points (and links the best neighbour as parent when
+  // this keyframe has none).
+  void updateConnections();
+  int trackedPoints(int min_observations) const;
+};
+
+}  // namespace hiveslam::core

@@ -1,0 +1,55 @@
+#include "core/map/map.hpp"
+
+namespace hiveslam::core {
+
+void Map::observe(KeyFrame& kf, int index, const std::shared_ptr<MapPoint>& p) {
+  kf.points[static_cast<size_t>(index)] = p;
+  p->observations[&kf] = index;
+}
+
+void Map::erase(MapPoint& p) {
+  p.bad = true;
+  for (const auto& [kf, idx] : p.observations) kf->points[static_cast<size_t>(idx)].reset();
+  p.observations.clear();
+  points.erase(p.id);
+}
+
+void Map::replace(MapPoint& old, const std::shared_ptr<MapPoint>& by) {
+  if (&old == by.get()) return;
+  for (const auto& [kf, idx] : old.observations) {
+    if (by->observations.count(kf)) {
+      kf->points[static_cast<size_t>(idx)].reset();  // already sees `by` at another keypoint
+    } else {
+      observe(*kf, idx, by);
+    }
+  }
+  by->visible += old.visible;
+  by->found += old.found;
+  old.observations.clear();
+  old.bad = true;
+  points.erase(old.id);
+}
+
+void Map::erase(KeyFrame& kf) {
+  if (&kf == origin) return;  // the origin anchors the map's coordinate frame
+  kf.bad = true;
+  for (auto& p : kf.points)
+    if (p) {
+      p->observations.erase(&kf);
+      p.reset();
+    }
+  for (auto& [other, w] : kf.covisibility) other->covisibility.erase(&kf);
+  // Children are re-parented to this keyframe's parent (keeps the spanning tree connected).
+  for (KeyFrame* child : kf.children) {
+    child->parent = kf.parent;
+    if (kf.parent) kf.parent->children.insert(child);
+  }
+  if (kf.parent) kf.parent->children.erase(&kf);
+  kf.children.clear();
+  if (auto it = keyframes.find(kf.id); it != keyframes.end()) {
+    retired.push_back(it->second);
+    keyframes.erase(it);
+  }
+}
+
+}  // namespace hiveslam::core

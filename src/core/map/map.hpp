@@ -1,0 +1,41 @@
+#pragma once
+// A map: keyframes and map points in one coordinate frame.
+//
+// Locking rule (the one rule for shared map objects): every read or write of a map's keyframes
+// and map points, and of their fields, happens while holding that map's `mutex`. Modules take it
+// for one step at a time (a tracking query, a local BA write-back) and never hold two maps'
+// mutexes at once.
+#include <memory>
+#include <mutex>
+#include <unordered_map>
+#include <vector>
+
+#include "core/map/keyframe.hpp"
+#include "core/map/map_point.hpp"
+
+namespace hiveslam::core {
+
+class Map {
+ public:
+  explicit Map(Id id) : id(id) {}
+  const Id id;
+  mutable std::mutex mutex;
+  std::unordered_map<Id, std::shared_ptr<KeyFrame>> keyframes;
+  std::unordered_map<Id, std::shared_ptr<MapPoint>> points;
+  KeyFrame* origin = nullptr;  // the first keyframe, fixed in optimizations
+  // Culled keyframes stay alive (frames keep poses relative to them) but leave the map.
+  std::vector<std::shared_ptr<KeyFrame>> retired;
+
+  void add(const std::shared_ptr<KeyFrame>& kf) { keyframes[kf->id] = kf; }
+  void add(const std::shared_ptr<MapPoint>& p) { points[p->id] = p; }
+  // Adds the observation both ways.
+  static void observe(KeyFrame& kf, int index, const std::shared_ptr<MapPoint>& p);
+  // Removes a point from every keyframe that sees it and from the map.
+  void erase(MapPoint& p);
+  // Replaces `old` by `by` in every observation (duplicate fusion).
+  void replace(MapPoint& old, const std::shared_ptr<MapPoint>& by);
+  // Removes a keyframe: its observations go, its children move to its parent.
+  void erase(KeyFrame& kf);
+};
+
+}  // namespace hiveslam::core

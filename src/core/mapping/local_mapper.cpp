@@ -1,0 +1,280 @@
+#include "core/mapping/local_mapper.hpp"
+
+#include <cmath>
+#include <set>
+
+#include "core/features/hamming.hpp"
+#include "core/geometry/triangulation.hpp"
+#include "core/matching/projection_matcher.hpp"
+#include "core/optim/bundle_adjustment.hpp"
+
+namespace hiveslam::core {
+
+namespace {
+
+Eigen::Matrix3d skew(const Eigen::Vector3d& v) {
+  Eigen::Matrix3d m;
+  m << 0, -v.z(), v.y(), v.z(), 0, -v.x(), -v.y(), v.x(), 0;
+  return m;
+}
+
+}  // namespace
+
+LocalMapper::LocalMapper(const SlamSettings& settings, IdGenerator& ids, std::vector<double> scales)
+    : settings_(settings), ids_(ids), scales_(std::move(scales)) {}
+
+void LocalMapper::process(const std::shared_ptr<Map>& map, const std::shared_ptr<KeyFrame>& kf,
+                          const std::atomic<bool>* abort_ba) {
+  std::lock_guard lock(map->mutex);
+  insert(*map, *kf);
+  cullRecentPoints(*map, *kf);
+  triangulateNewPoints(*map, *kf);
+  fuse(*map, *kf);
+  if (map->keyframes.size() > 2) localBundleAdjustment(*map, *kf, abort_ba);
+  cullKeyframes(*map, *kf);
+  ++stats_.keyframes_processed;
+}
+
+void LocalMapper::insert(Map& map, KeyFrame& kf) {
+  if (!map.keyframes.count(kf.id)) map.add(kf.shared_from_this());
+  for (size_t i = 0; i < kf.points.size(); ++i) {
+    auto& p = kf.points[i];
+    if (!p) continue;
+    if (p->bad) {
+      p.reset();
+      continue;
+    }
+    if (!p->observations.count(&kf)) {
+      Map::observe(kf, static_cast<int>(i), p);
+      p->update(scales_);
+    }
+  }
+  kf.updateConnections();
+}
+
+void LocalMapper::cullRecentPoints(Map& map, const KeyFrame&) {
+  for (auto it = recent_.begin(); it != recent_.end();) {
+    MapPoint& p = *it->point;
+    ++it->keyframes_since;
+    if (p.bad) {
+      it = recent_.erase(it);
+    } else if (p.foundRatio() < 0.25 || (it->keyframes_since >= 2 && p.observations.size() <= 2)) {
+      map.erase(p);
+      ++stats_.points_culled;
+      it = recent_.erase(it);
+    } else if (it->keyframes_since >= 3) {
+      it = recent_.erase(it);
+    } else {
+      ++it;
+    }
+  }
+}
+
+void LocalMapper::triangulateNewPoints(Map& map, KeyFrame& kf) {
+  const Eigen::Isometry3d T1w = kf.T_cw;
+  const Eigen::Vector3d C1 = kf.center();
+  const Intrinsics& K = kf.frame.K;
+  const double f = 0.5 * (K.fx + K.fy);
+  for (KeyFrame* nb : kf.bestCovisible(static_cast<size_t>(settings_.triangulation_neighbours))) {
+    // Enough baseline relative to the scene depth, or the points would be poorly conditioned.
+    std::vector<double> depths;
+    for (const auto& p : nb->points)
+      if (p && !p->bad) depths.push_back((nb->T_cw * p->position).z());
+    if (depths.empty()) continue;
+    std::nth_element(depths.begin(), depths.begin() + depths.size() / 2, depths.end());
+    if ((nb->center() - C1).norm() / depths[depths.size() / 2] < 0.01) continue;
+
+    const Eigen::Isometry3d T21 = nb->T_cw * T1w.inverse();  // kf frame -> neighbour frame
+    // Epipolar constraint x2^T F21 x1 = 0 on the ideal pinhole images.
+    Eigen::Matrix3d Km;
+    Km << K.fx, 0, K.cx, 0, K.fy, K.cy, 0, 0, 1;
+    const Eigen::Matrix3d F21 = Km.inverse().transpose() * skew(T21.translation()) * T21.linear() * Km.inverse();
+    std::vector<int> taken(nb->points.size(), 0);
+    for (size_t i = 0; i < kf.points.size(); ++i) {
+      if (kf.points[i]) continue;
+      const Eigen::Vector3d l2 = F21 * kf.frame.points[i].homogeneous();
+      const double norm2 = l2.head<2>().squaredNorm();
+      const uchar* d1 = kf.frame.descriptors.ptr<uchar>(static_cast<int>(i));
+      int best = kMatchLow + 1, best_j = -1;
+      for (size_t j = 0; j < nb->points.size(); ++j) {
+        if (nb->points[j] || taken[j]) continue;
+        const double e = nb->frame.points[j].homogeneous().dot(l2);
+        const double s2 = scales_[static_cast<size_t>(nb->frame.keypoints[j].octave)];
+        if (e * e / norm2 > 3.84 * s2 * s2) continue;
+        const int d = features::hamming(d1, nb->frame.descriptors.ptr<uchar>(static_cast<int>(j)));
+        if (d < best) {
+          best = d;
+          best_j = static_cast<int>(j);
+        }
+      }
+      if (best_j < 0) continue;
+      const size_t j = static_cast<size_t>(best_j);
+      const double s1 = scales_[static_cast<size_t>(kf.frame.keypoints[i].octave)];
+      const double s2 = scales_[static_cast<size_t>(nb->frame.keypoints[j].octave)];
+      TriangulationCheck check{std::sqrt(5.991) * std::max(s1, s2), 0.9998};
+      const auto X1 = triangulate(K.ray(kf.frame.points[i]), K.ray(nb->frame.points[j]), T21, f, check);
+      if (!X1) continue;
+      const Eigen::Vector3d Xw = T1w.inverse() * *X1;
+      // Scale consistency: distance ratio against pyramid scale ratio.
+      const double ratio_dist = (Xw - C1).norm() / std::max((Xw - nb->center()).norm(), 1e-9);
+      const double ratio_scale = s1 / s2;
+      if (ratio_dist * 1.8 < ratio_scale || ratio_dist > ratio_scale * 1.8) continue;
+      auto p = std::make_shared<MapPoint>(ids_.next(), Xw, kf.id);
+      Map::observe(kf, static_cast<int>(i), p);
+      Map::observe(*nb, best_j, p);
+      p->update(scales_);
+      map.add(p);
+      recent_.push_back({p, 0});
+      taken[j] = 1;
+      ++stats_.points_created;
+    }
+  }
+}
+
+namespace {
+
+// Projects `points` into `kf` and merges each with the keypoint found there: observation added,
+// or the two points fused (the one with more observations survives).
+void fuseInto(Map& map, KeyFrame& kf, const std::vector<std::shared_ptr<MapPoint>>& points,
+              const std::vector<double>& scales) {
+  const Eigen::Vector3d C = kf.center();
+  for (const auto& p : points) {
+    if (!p || p->bad || p->observations.count(&kf)) continue;
+    const Eigen::Vector3d pc = kf.T_cw * p->position;
+    if (pc.z() <= 0) continue;
+    const Eigen::Vector2d uv = kf.frame.K.project(pc);
+    if (!kf.frame.inImage(uv)) continue;
+    const Eigen::Vector3d ray = p->position - C;
+    const double dist = ray.norm();
+    if (dist < 0.8 * p->min_distance || dist > 1.2 * p->max_distance || ray.dot(p->normal) < 0.5 * dist) continue;
+    const int level = p->predictLevel(dist, scales);
+    const double s = scales[static_cast<size_t>(level)];
+    const int j = bestNear(kf.frame, uv, 3.0 * s, level - 1, level + 1, p->descriptor.ptr<uchar>(), kMatchLow);
+    if (j < 0) continue;
+    const double s_kp = scales[static_cast<size_t>(kf.frame.keypoints[static_cast<size_t>(j)].octave)];
+    if ((kf.frame.points[static_cast<size_t>(j)] - uv).squaredNorm() > 5.991 * s_kp * s_kp) continue;
+    auto existing = kf.points[static_cast<size_t>(j)];
+    if (existing && !existing->bad) {
+      if (existing == p) continue;
+      if (existing->observations.size() > p->observations.size()) map.replace(*p, existing);
+      else map.replace(*existing, p);
+    } else {
+      Map::observe(kf, j, p);
+    }
+  }
+}
+
+}  // namespace
+
+void LocalMapper::fuse(Map& map, KeyFrame& kf) {
+  std::vector<KeyFrame*> targets;
+  std::set<KeyFrame*> in;
+  for (KeyFrame* n : kf.bestCovisible(static_cast<size_t>(settings_.fusion_neighbours))) {
+    if (in.insert(n).second) targets.push_back(n);
+    for (KeyFrame* n2 : n->bestCovisible(5))
+      if (n2 != &kf && in.insert(n2).second) targets.push_back(n2);
+  }
+  for (KeyFrame* t : targets) fuseInto(map, *t, kf.points, scales_);
+  std::vector<std::shared_ptr<MapPoint>> theirs;
+  std::set<MapPoint*> seen;
+  for (KeyFrame* t : targets)
+    for (const auto& p : t->points)
+      if (p && !p->bad && seen.insert(p.get()).second) theirs.push_back(p);
+  fuseInto(map, kf, theirs, scales_);
+  for (const auto& p : kf.points)
+    if (p && !p->bad) p->update(scales_);
+  kf.updateConnections();
+}
+
+void LocalMapper::localBundleAdjustment(Map& map, KeyFrame& kf, const std::atomic<bool>* abort) {
+  std::vector<KeyFrame*> local{&kf};
+  for (const auto& [n, w] : kf.covisibility)
+    if (!n->bad) local.push_back(n);
+  std::set<KeyFrame*> local_set(local.begin(), local.end());
+  std::vector<MapPoint*> pts;
+  std::set<MapPoint*> pts_set;
+  for (KeyFrame* k : local)
+    for (const auto& p : k->points)
+      if (p && !p->bad && pts_set.insert(p.get()).second) pts.push_back(p.get());
+  // Keyframes outside the local window that see local points hold the border fixed.
+  std::vector<KeyFrame*> fixed;
+  std::set<KeyFrame*> fixed_set;
+  for (MapPoint* p : pts)
+    for (const auto& [k, idx] : p->observations)
+      if (!local_set.count(k) && !k->bad && fixed_set.insert(k).second) fixed.push_back(k);
+
+  BaProblem ba;
+  ba.K = kf.frame.K;
+  std::map<KeyFrame*, int> pose_index;
+  for (KeyFrame* k : local) {
+    pose_index[k] = static_cast<int>(ba.poses.size());
+    ba.poses.push_back({Eigen::Quaterniond(k->T_cw.linear()), k->T_cw.translation(), k == map.origin});
+  }
+  for (KeyFrame* k : fixed) {
+    pose_index[k] = static_cast<int>(ba.poses.size());
+    ba.poses.push_back({Eigen::Quaterniond(k->T_cw.linear()), k->T_cw.translation(), true});
+  }
+  // With a monocular gauge, at least two fixed poses keep the scale: fix the oldest local one
+  // too when the window has no other anchor.
+  if (fixed.empty() && local.size() > 1) {
+    KeyFrame* oldest = *std::min_element(local.begin(), local.end(), [](KeyFrame* a, KeyFrame* b) { return a->id < b->id; });
+    ba.poses[static_cast<size_t>(pose_index[oldest])].fixed = true;
+  }
+  std::vector<std::pair<KeyFrame*, MapPoint*>> obs_refs;
+  for (size_t i = 0; i < pts.size(); ++i) {
+    ba.points.push_back({pts[i]->position, false});
+    for (const auto& [k, idx] : pts[i]->observations) {
+      auto it = pose_index.find(k);
+      if (it == pose_index.end()) continue;
+      ba.observations.push_back({it->second, static_cast<int>(i), k->frame.points[static_cast<size_t>(idx)],
+                                 1.0 / scales_[static_cast<size_t>(k->frame.keypoints[static_cast<size_t>(idx)].octave)]});
+      obs_refs.emplace_back(k, pts[i]);
+    }
+  }
+  BaOptions o;
+  o.iterations = settings_.local_ba_iterations;
+  o.abort = abort;
+  const BaSummary s = bundleAdjust(ba, o);
+  ++stats_.local_bas;
+  for (KeyFrame* k : local) {
+    const auto& pose = ba.poses[static_cast<size_t>(pose_index[k])];
+    k->T_cw.linear() = pose.q_cw.normalized().toRotationMatrix();
+    k->T_cw.translation() = pose.t_cw;
+  }
+  for (size_t i = 0; i < pts.size(); ++i) pts[i]->position = ba.points[i].p_w;
+  for (size_t i = 0; i < obs_refs.size(); ++i) {
+    if (!s.outlier[i]) continue;
+    auto [k, p] = obs_refs[i];
+    auto it = p->observations.find(k);
+    if (it == p->observations.end()) continue;
+    k->points[static_cast<size_t>(it->second)].reset();
+    p->observations.erase(it);
+    if (p->observations.size() < 2 && !p->bad) map.erase(*p);
+  }
+  for (MapPoint* p : pts)
+    if (!p->bad) p->update(scales_);
+}
+
+void LocalMapper::cullKeyframes(Map& map, KeyFrame& kf) {
+  for (KeyFrame* k : kf.bestCovisible(1000)) {
+    if (k == map.origin || k == &kf || k->bad) continue;
+    int total = 0, redundant = 0;
+    for (size_t i = 0; i < k->points.size(); ++i) {
+      const auto& p = k->points[i];
+      if (!p || p->bad) continue;
+      ++total;
+      if (p->observations.size() <= 3) continue;
+      const int level = k->frame.keypoints[i].octave;
+      int others = 0;
+      for (const auto& [o, idx] : p->observations)
+        if (o != k && o->frame.keypoints[static_cast<size_t>(idx)].octave <= level + 1 && ++others >= 3) break;
+      if (others >= 3) ++redundant;
+    }
+    if (total > 0 && redundant > settings_.redundant_keyframe_ratio * total) {
+      map.erase(*k);
+      ++stats_.keyframes_culled;
+    }
+  }
+}
+
+}  // namespace hiveslam::core

@@ -1,0 +1,47 @@
+#pragma once
+// The local mapping module: inserts keyframes from tracking into the map, culls weak recent
+// points, triangulates new points with covisible keyframes, fuses duplicates, runs local BA
+// and culls redundant keyframes.
+#include <atomic>
+#include <list>
+#include <memory>
+
+#include "core/map/map.hpp"
+#include "core/system/slam_settings.hpp"
+
+namespace hiveslam::core {
+
+struct MappingStats {
+  int keyframes_processed = 0, points_created = 0, points_culled = 0, keyframes_culled = 0, local_bas = 0;
+};
+
+class LocalMapper {
+ public:
+  LocalMapper(const SlamSettings& settings, IdGenerator& ids, std::vector<double> scales);
+
+  // Runs every step for one keyframe of `map` (the caller holds no lock; each step takes the
+  // map's mutex). `abort_ba` lets a newer keyframe cut the local BA short.
+  void process(const std::shared_ptr<Map>& map, const std::shared_ptr<KeyFrame>& kf,
+               const std::atomic<bool>* abort_ba = nullptr);
+  const MappingStats& stats() const { return stats_; }
+
+ private:
+  void insert(Map& map, KeyFrame& kf);
+  void cullRecentPoints(Map& map, const KeyFrame& kf);
+  void triangulateNewPoints(Map& map, KeyFrame& kf);
+  void fuse(Map& map, KeyFrame& kf);
+  void localBundleAdjustment(Map& map, KeyFrame& kf, const std::atomic<bool>* abort);
+  void cullKeyframes(Map& map, KeyFrame& kf);
+
+  SlamSettings settings_;
+  IdGenerator& ids_;
+  std::vector<double> scales_;
+  struct Recent {
+    std::shared_ptr<MapPoint> point;
+    int keyframes_since = 0;
+  };
+  std::list<Recent> recent_;
+  MappingStats stats_;
+};
+
+}  // namespace hiveslam::core

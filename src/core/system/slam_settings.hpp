@@ -1,0 +1,39 @@
+#pragma once
+// Every threshold of the SLAM core in one plain struct with its defaults; the settings file's
+// `slam:` section overrides any of them (io/slam_settings_io reads it).
+#include <cstdint>
+
+#include "core/features/orb_extractor.hpp"
+
+namespace hiveslam::core {
+
+struct SlamSettings {
+  features::OrbOptions orb;
+  // Initialization
+  int init_min_matches = 100;
+  double init_min_parallax_deg = 1.0;
+  int init_min_points = 50;
+  // Tracking
+  double search_radius_last_frame = 15.0;  // pixels at level 0
+  int min_matches_last_frame = 20;
+  int min_inliers_tracking = 30;
+  int min_inliers_after_relocalization = 50;
+  int local_keyframes = 10;                // covisible keyframes around the tracked points
+  // Keyframe decision (the paper's rule: >= 2 frames since the last keyframe, ratio 0.8)
+  int keyframe_min_frames = 2;
+  int keyframe_max_frames = 20;            // a keyframe at least this often (about 1 s)
+  double keyframe_ratio = 0.8;             // tracked / reference keyframe's points below this
+  int keyframe_min_inliers = 15;
+  // Loss handling: a new map after this many lost frames once the map is past its first
+  // keyframes (the paper's wait for the initial keyframes to be optimized).
+  int lost_frames_before_new_map = 20;
+  // Local mapping
+  int triangulation_neighbours = 10;
+  int fusion_neighbours = 10;
+  int local_ba_iterations = 10;
+  double redundant_keyframe_ratio = 0.9;
+  // Determinism: RANSAC seed
+  uint64_t seed = 1;
+};
+
+}  // namespace hiveslam::core

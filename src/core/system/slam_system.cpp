@@ -1,0 +1,45 @@
+#include "core/system/slam_system.hpp"
+
+#include <chrono>
+
+namespace hiveslam::core {
+
+SlamSystem::SlamSystem(const SlamSettings& settings, std::shared_ptr<const camera::CameraModel> camera, uint16_t node)
+    : settings_(settings),
+      camera_(std::move(camera)),
+      ids_(node),
+      extractor_(settings.orb),
+      tracker_(settings, ids_, extractor_.scales()),
+      mapper_(settings, ids_, extractor_.scales()) {}
+
+const FrameRecord& SlamSystem::process(const cv::Mat& gray, double timestamp) {
+  const auto t0 = std::chrono::steady_clock::now();
+  FrameRecord r;
+  r.index = records_.size();
+  r.timestamp = timestamp;
+  TrackingOutput out = tracker_.track(makeFrame(gray, r.index, timestamp, extractor_, *camera_), true);
+  r.tracking_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  if (out.new_map) maps_.push_back(out.new_map);
+  if (out.tracked && out.reference) {
+    r.tracked = true;
+    r.reference = out.reference;
+    r.T_c_ref = out.T_cw * out.reference->T_cw.inverse();
+    r.map = tracker_.map()->id;
+  }
+  if (out.new_keyframe) mapper_.process(tracker_.map(), out.new_keyframe);
+  records_.push_back(std::move(r));
+  return records_.back();
+}
+
+Eigen::Isometry3d SlamSystem::poseOf(const FrameRecord& r) const {
+  return (r.T_c_ref * r.reference->T_cw).inverse();
+}
+
+std::shared_ptr<Map> SlamSystem::largestMap() const {
+  std::shared_ptr<Map> best;
+  for (const auto& m : maps_)
+    if (!best || m->keyframes.size() > best->keyframes.size()) best = m;
+  return best;
+}
+
+}  // namespace hiveslam::core

@@ -1,0 +1,362 @@
+#include "core/tracking/tracker.hpp"
+
+#include <algorithm>
+#include <opencv2/calib3d.hpp>
+#include <set>
+
+#include "core/features/hamming.hpp"
+#include "core/geometry/two_view.hpp"
+#include "core/matching/initial_matcher.hpp"
+#include "core/optim/bundle_adjustment.hpp"
+#include "core/optim/pose_optimizer.hpp"
+
+namespace hiveslam::core {
+
+Tracker::Tracker(const SlamSettings& settings, IdGenerator& ids, std::vector<double> scales)
+    : settings_(settings), ids_(ids), scales_(std::move(scales)) {}
+
+TrackingOutput Tracker::track(Frame frame, bool mapping_idle) {
+  TrackingOutput out;
+  Tracked current;
+  current.points.assign(frame.size(), nullptr);
+  current.outlier.assign(frame.size(), false);
+  current.frame = std::move(frame);
+
+  if (state_ == TrackingState::NotInitialized) {
+    if (initialize(current, out)) {
+      state_ = TrackingState::Ok;
+      out.tracked = true;
+    }
+    out.state = state_;
+    return out;
+  }
+
+  std::unique_lock lock(map_->mutex);
+  bool ok = false;
+  if (state_ == TrackingState::Ok) {
+    ok = (have_velocity_ && trackWithMotionModel(current)) || trackReferenceKeyframe(current);
+    if (ok) ok = trackLocalMap(current, current.frame.index < last_relocalization_frame_ + 20
+                                            ? settings_.min_inliers_after_relocalization
+                                            : settings_.min_inliers_tracking);
+    if (!ok) {
+      ++failures_;
+      lost_frames_ = 0;
+    }
+  } else {
+    ok = relocalize(current);
+    if (ok) {
+      last_relocalization_frame_ = current.frame.index;
+    }
+  }
+
+  if (!ok) {
+    state_ = TrackingState::Lost;
+    have_velocity_ = false;
+    ++lost_frames_;
+    // A young map that loses track is abandoned at once; an established one gets a few frames
+    // to relocalize before a new map is started.
+    if (map_->keyframes.size() <= 5 || lost_frames_ > settings_.lost_frames_before_new_map) {
+      lock.unlock();
+      state_ = TrackingState::NotInitialized;
+      init_reference_.reset();
+      last_.reset();
+    }
+    out.state = state_;
+    return out;
+  }
+
+  state_ = TrackingState::Ok;
+  lost_frames_ = 0;
+  if (last_) {
+    velocity_ = current.T_cw * last_->T_cw.inverse();
+    have_velocity_ = true;
+  }
+  out.tracked = true;
+  out.T_cw = current.T_cw;
+  out.inliers = inliers_;
+  if (needKeyframe(current, mapping_idle)) {
+    out.new_keyframe = makeKeyframe(current);
+    reference_ = out.new_keyframe;
+    last_keyframe_frame_ = current.frame.index;
+  }
+  out.reference = reference_;
+  out.state = state_;
+  // Outliers do not go forward to the next frame's matching.
+  for (size_t i = 0; i < current.points.size(); ++i)
+    if (current.outlier[i]) current.points[i].reset();
+  last_ = std::move(current);
+  return out;
+}
+
+bool Tracker::initialize(Tracked& current, TrackingOutput& out) {
+  if (!init_reference_ || current.frame.size() <= static_cast<size_t>(settings_.init_min_matches)) {
+    if (current.frame.size() > static_cast<size_t>(settings_.init_min_matches)) {
+      init_reference_ = current;
+      init_prev_matched_ = current.frame.points;
+    }
+    return false;
+  }
+  const Frame& f1 = init_reference_->frame;
+  const Frame& f2 = current.frame;
+  const std::vector<int> m = matchForInitialization(f1, f2, {}, &init_prev_matched_);
+  std::vector<Eigen::Vector2d> p1, p2;
+  std::vector<size_t> idx1;
+  for (size_t i = 0; i < m.size(); ++i)
+    if (m[i] >= 0) {
+      p1.push_back(f1.points[i]);
+      p2.push_back(f2.points[static_cast<size_t>(m[i])]);
+      idx1.push_back(i);
+      init_prev_matched_[i] = f2.points[static_cast<size_t>(m[i])];
+    }
+  if (static_cast<int>(p1.size()) < settings_.init_min_matches) {
+    init_reference_ = current;  // too little overlap: start again from this frame
+    init_prev_matched_ = current.frame.points;
+    return false;
+  }
+  TwoViewOptions o;
+  o.min_points = settings_.init_min_points;
+  o.min_parallax_deg = settings_.init_min_parallax_deg;
+  o.seed = settings_.seed + current.frame.index;
+  const TwoViewResult r = initializeTwoView(p1, p2, f1.K, o);
+  if (!r.ok) return false;
+
+  // The new map: two keyframes, the triangulated points, a full BA, median depth 1.
+  auto map = std::make_shared<Map>(ids_.next());
+  auto kf1 = std::make_shared<KeyFrame>(ids_.next(), f1, Eigen::Isometry3d::Identity());
+  auto kf2 = std::make_shared<KeyFrame>(ids_.next(), f2, r.T_21);
+  map->add(kf1);
+  map->add(kf2);
+  map->origin = kf1.get();
+  for (size_t k = 0; k < p1.size(); ++k) {
+    if (!r.good[k]) continue;
+    auto p = std::make_shared<MapPoint>(ids_.next(), r.points[k], kf1->id);
+    Map::observe(*kf1, static_cast<int>(idx1[k]), p);
+    Map::observe(*kf2, m[idx1[k]], p);
+    p->update(scales_);
+    map->add(p);
+  }
+  kf1->updateConnections();
+  kf2->updateConnections();
+  {
+    BaProblem ba;
+    ba.K = f1.K;
+    std::vector<KeyFrame*> kfs{kf1.get(), kf2.get()};
+    for (auto* kf : kfs) ba.poses.push_back({Eigen::Quaterniond(kf->T_cw.linear()), kf->T_cw.translation(), kf == kf1.get()});
+    std::vector<MapPoint*> pts;
+    for (auto& [id, p] : map->points) {
+      const int pi = static_cast<int>(pts.size());
+      pts.push_back(p.get());
+      ba.points.push_back({p->position, false});
+      for (int k = 0; k < 2; ++k) {
+        const int kp = p->observations.at(kfs[static_cast<size_t>(k)]);
+        ba.observations.push_back({k, pi, kfs[static_cast<size_t>(k)]->frame.points[static_cast<size_t>(kp)],
+                                   1.0 / scales_[static_cast<size_t>(kfs[static_cast<size_t>(k)]->frame.keypoints[static_cast<size_t>(kp)].octave)]});
+      }
+    }
+    BaOptions bo;
+    bo.iterations = 20;
+    const BaSummary s = bundleAdjust(ba, bo);
+    kf2->T_cw.linear() = ba.poses[1].q_cw.normalized().toRotationMatrix();
+    kf2->T_cw.translation() = ba.poses[1].t_cw;
+    for (size_t i = 0; i < pts.size(); ++i) pts[i]->position = ba.points[i].p_w;
+    for (size_t i = 0; i < ba.observations.size(); ++i)
+      if (s.outlier[i]) {
+        MapPoint* p = pts[static_cast<size_t>(ba.observations[i].point)];
+        if (!p->bad) map->erase(*p);
+      }
+  }
+  // Median depth of the first keyframe's points becomes 1.
+  std::vector<double> depths;
+  for (const auto& p : kf1->points)
+    if (p && !p->bad) depths.push_back(p->position.z());
+  if (depths.size() < static_cast<size_t>(settings_.init_min_points)) return false;
+  std::nth_element(depths.begin(), depths.begin() + depths.size() / 2, depths.end());
+  const double median = depths[depths.size() / 2];
+  if (median <= 0) return false;
+  const double s = 1.0 / median;
+  kf2->T_cw.translation() *= s;
+  for (auto& [id, p] : map->points) {
+    p->position *= s;
+    p->update(scales_);
+  }
+  map_ = map;
+  reference_ = kf2;
+  current.T_cw = kf2->T_cw;
+  current.points = kf2->points;
+  current.outlier.assign(current.points.size(), false);
+  last_ = current;
+  have_velocity_ = false;
+  last_keyframe_frame_ = current.frame.index;
+  init_reference_.reset();
+  out.new_map = map;
+  out.new_keyframe = kf2;
+  out.reference = kf2;
+  out.T_cw = kf2->T_cw;
+  out.inliers = static_cast<int>(map->points.size());
+  return true;
+}
+
+int Tracker::optimize(Tracked& c) {
+  std::vector<PoseObservation> obs;
+  std::vector<size_t> which;
+  for (size_t i = 0; i < c.points.size(); ++i)
+    if (c.points[i] && !c.points[i]->bad) {
+      obs.push_back({c.points[i]->position, c.frame.points[i], 1.0 / scales_[static_cast<size_t>(c.frame.keypoints[i].octave)]});
+      which.push_back(i);
+    }
+  std::vector<bool> outlier;
+  const int inliers = optimizePose(c.frame.K, obs, c.T_cw, outlier);
+  c.outlier.assign(c.points.size(), false);
+  for (size_t k = 0; k < which.size(); ++k) c.outlier[which[k]] = outlier[k];
+  return inliers;
+}
+
+bool Tracker::trackWithMotionModel(Tracked& c) {
+  c.T_cw = velocity_ * last_->T_cw;
+  std::fill(c.points.begin(), c.points.end(), nullptr);
+  int n = matchFromLastFrame(c.frame, c.T_cw, c.points, last_->frame, last_->points, last_->outlier,
+                             settings_.search_radius_last_frame, scales_, true);
+  if (n < settings_.min_matches_last_frame) {
+    std::fill(c.points.begin(), c.points.end(), nullptr);
+    n = matchFromLastFrame(c.frame, c.T_cw, c.points, last_->frame, last_->points, last_->outlier,
+                           2 * settings_.search_radius_last_frame, scales_, true);
+  }
+  if (n < settings_.min_matches_last_frame) return false;
+  return optimize(c) >= 10;
+}
+
+bool Tracker::trackReferenceKeyframe(Tracked& c) {
+  if (!last_ || !reference_) return false;
+  // Without a velocity: the reference keyframe's points projected from the last pose with a
+  // wide window (the bag-of-words search replaces this in the next layer of the core).
+  c.T_cw = last_->T_cw;
+  std::fill(c.points.begin(), c.points.end(), nullptr);
+  std::vector<bool> no_outliers(reference_->points.size(), false);
+  const int n = matchFromLastFrame(c.frame, c.T_cw, c.points, reference_->frame, reference_->points, no_outliers,
+                                   3 * settings_.search_radius_last_frame, scales_, true);
+  if (n < 15) return false;
+  return optimize(c) >= 10;
+}
+
+bool Tracker::trackLocalMap(Tracked& c, int min_inliers) {
+  // Local keyframes: those seeing the current matches, plus their best covisible neighbours.
+  std::map<KeyFrame*, int> votes;
+  for (size_t i = 0; i < c.points.size(); ++i)
+    if (c.points[i] && !c.outlier[i] && !c.points[i]->bad)
+      for (const auto& [kf, idx] : c.points[i]->observations) ++votes[kf];
+  std::vector<KeyFrame*> local;
+  std::set<KeyFrame*> in_local;
+  KeyFrame* best = nullptr;
+  int best_votes = 0;
+  for (const auto& [kf, v] : votes) {
+    if (kf->bad) continue;
+    local.push_back(kf);
+    in_local.insert(kf);
+    if (v > best_votes) {
+      best_votes = v;
+      best = kf;
+    }
+  }
+  const size_t direct = local.size();
+  for (size_t k = 0; k < direct && local.size() < 80; ++k)
+    for (KeyFrame* n : local[k]->bestCovisible(static_cast<size_t>(settings_.local_keyframes)))
+      if (in_local.insert(n).second) local.push_back(n);
+  if (best) reference_ = best->shared_from_this();
+  // Local points not matched yet.
+  std::set<MapPoint*> matched;
+  for (size_t i = 0; i < c.points.size(); ++i)
+    if (c.points[i]) {
+      if (c.outlier[i]) c.points[i].reset();
+      else matched.insert(c.points[i].get());
+    }
+  std::vector<std::shared_ptr<MapPoint>> candidates;
+  std::set<MapPoint*> seen;
+  for (KeyFrame* kf : local)
+    for (const auto& p : kf->points)
+      if (p && !p->bad && !matched.count(p.get()) && seen.insert(p.get()).second) candidates.push_back(p);
+  matchLocalMap(c.frame, c.T_cw, c.points, candidates, c.frame.index < last_relocalization_frame_ + 2 ? 5.0 : 1.0, scales_);
+  optimize(c);
+  inliers_ = 0;
+  for (size_t i = 0; i < c.points.size(); ++i)
+    if (c.points[i] && !c.outlier[i]) {
+      ++c.points[i]->found;
+      if (!c.points[i]->observations.empty()) ++inliers_;
+    }
+  return inliers_ >= min_inliers;
+}
+
+bool Tracker::relocalize(Tracked& c) {
+  // Candidates: the most recent keyframes (bag-of-words candidates come with the next layer).
+  std::vector<std::shared_ptr<KeyFrame>> kfs;
+  for (const auto& [id, kf] : map_->keyframes) kfs.push_back(kf);
+  std::sort(kfs.begin(), kfs.end(), [](const auto& a, const auto& b) { return a->id > b->id; });
+  const size_t stride = std::max<size_t>(1, kfs.size() / 20);
+  for (size_t k = 0; k < kfs.size(); k += stride) {
+    const KeyFrame& kf = *kfs[k];
+    std::vector<cv::Point3d> object;
+    std::vector<cv::Point2d> image;
+    std::vector<int> index;
+    PointSlots slots(c.frame.size());
+    for (size_t j = 0; j < kf.points.size(); ++j) {
+      const auto& p = kf.points[j];
+      if (!p || p->bad) continue;
+      int best = 256, second = 256, best_i = -1;
+      for (int i = 0; i < static_cast<int>(c.frame.size()); ++i) {
+        const int d = features::hamming(p->descriptor.ptr<uchar>(), c.frame.descriptors.ptr<uchar>(i));
+        if (d < best) {
+          second = best;
+          best = d;
+          best_i = i;
+        } else if (d < second) {
+          second = d;
+        }
+      }
+      if (best_i < 0 || best > kMatchLow || best > 0.75 * second || slots[static_cast<size_t>(best_i)]) continue;
+      slots[static_cast<size_t>(best_i)] = p;
+      object.emplace_back(p->position.x(), p->position.y(), p->position.z());
+      image.emplace_back(c.frame.points[static_cast<size_t>(best_i)].x(), c.frame.points[static_cast<size_t>(best_i)].y());
+      index.push_back(best_i);
+    }
+    if (object.size() < 15) continue;
+    cv::Mat rvec, tvec, inliers;
+    const cv::Matx33d K(c.frame.K.fx, 0, c.frame.K.cx, 0, c.frame.K.fy, c.frame.K.cy, 0, 0, 1);
+    cv::setRNGSeed(static_cast<int>((settings_.seed + c.frame.index) & 0x7fffffff));
+    if (!cv::solvePnPRansac(object, image, K, cv::noArray(), rvec, tvec, false, 300, 4.0f, 0.99, inliers,
+                            cv::SOLVEPNP_EPNP) ||
+        inliers.rows < 10)
+      continue;
+    cv::Mat R;
+    cv::Rodrigues(rvec, R);
+    Eigen::Matrix3d Re;
+    for (int r = 0; r < 3; ++r)
+      for (int q = 0; q < 3; ++q) Re(r, q) = R.at<double>(r, q);
+    c.T_cw.linear() = Re;
+    c.T_cw.translation() = Eigen::Vector3d(tvec.at<double>(0), tvec.at<double>(1), tvec.at<double>(2));
+    c.points = slots;
+    if (optimize(c) < 10) continue;
+    reference_ = kfs[k];
+    if (trackLocalMap(c, settings_.min_inliers_after_relocalization)) return true;
+  }
+  return false;
+}
+
+bool Tracker::needKeyframe(const Tracked& c, bool mapping_idle) const {
+  const size_t since = c.frame.index - last_keyframe_frame_;
+  if (since < static_cast<size_t>(settings_.keyframe_min_frames)) return false;
+  if (c.frame.index < last_relocalization_frame_ + static_cast<size_t>(settings_.keyframe_max_frames) &&
+      map_->keyframes.size() > static_cast<size_t>(settings_.keyframe_max_frames))
+    return false;
+  const int reference_points = reference_ ? reference_->trackedPoints(map_->keyframes.size() <= 2 ? 2 : 3) : 0;
+  const bool timely = since >= static_cast<size_t>(settings_.keyframe_max_frames) || mapping_idle;
+  const bool weak = inliers_ < settings_.keyframe_ratio * reference_points && inliers_ > settings_.keyframe_min_inliers;
+  return timely && weak;
+}
+
+std::shared_ptr<KeyFrame> Tracker::makeKeyframe(const Tracked& c) {
+  auto kf = std::make_shared<KeyFrame>(ids_.next(), c.frame, c.T_cw);
+  for (size_t i = 0; i < c.points.size(); ++i)
+    if (c.points[i] && !c.outlier[i] && !c.points[i]->bad) kf->points[i] = c.points[i];
+  return kf;
+}
+
+}  // namespace hiveslam::core

@@ -1,0 +1,69 @@
+#pragma once
+// The tracking module: for every frame, the camera pose against the current map (constant
+// velocity prediction, reference keyframe fallback, local map refinement), the keyframe
+// decision, relocalization when lost, and two-view initialization of new maps.
+#include <functional>
+#include <memory>
+#include <optional>
+
+#include "core/map/map.hpp"
+#include "core/matching/projection_matcher.hpp"
+#include "core/system/slam_settings.hpp"
+
+namespace hiveslam::core {
+
+enum class TrackingState { NotInitialized, Ok, Lost };
+
+struct TrackingOutput {
+  TrackingState state = TrackingState::NotInitialized;
+  bool tracked = false;
+  Eigen::Isometry3d T_cw = Eigen::Isometry3d::Identity();
+  std::shared_ptr<KeyFrame> reference;      // the pose is kept relative to it
+  std::shared_ptr<KeyFrame> new_keyframe;   // for local mapping (also the initial two)
+  std::shared_ptr<Map> new_map;             // set when initialization created a map
+  int inliers = 0;
+};
+
+class Tracker {
+ public:
+  Tracker(const SlamSettings& settings, IdGenerator& ids, std::vector<double> scales);
+
+  // mapping_idle: local mapping has no keyframe waiting (keyframe decision input).
+  TrackingOutput track(Frame frame, bool mapping_idle);
+  TrackingState state() const { return state_; }
+  int failures() const { return failures_; }
+  const std::shared_ptr<Map>& map() const { return map_; }
+
+ private:
+  struct Tracked {
+    Frame frame;
+    Eigen::Isometry3d T_cw = Eigen::Isometry3d::Identity();
+    PointSlots points;
+    std::vector<bool> outlier;
+  };
+
+  bool initialize(Tracked& current, TrackingOutput& out);
+  bool trackWithMotionModel(Tracked& current);
+  bool trackReferenceKeyframe(Tracked& current);
+  bool trackLocalMap(Tracked& current, int min_inliers);
+  bool relocalize(Tracked& current);
+  int optimize(Tracked& current);
+  bool needKeyframe(const Tracked& current, bool mapping_idle) const;
+  std::shared_ptr<KeyFrame> makeKeyframe(const Tracked& current);
+
+  SlamSettings settings_;
+  IdGenerator& ids_;
+  std::vector<double> scales_;
+  TrackingState state_ = TrackingState::NotInitialized;
+  std::shared_ptr<Map> map_;
+  std::shared_ptr<KeyFrame> reference_;
+  std::optional<Tracked> last_;
+  std::optional<Tracked> init_reference_;          // first frame of an initialization attempt
+  std::vector<Eigen::Vector2d> init_prev_matched_;  // where its keypoints were last seen
+  Eigen::Isometry3d velocity_ = Eigen::Isometry3d::Identity();
+  bool have_velocity_ = false;
+  size_t last_keyframe_frame_ = 0, last_relocalization_frame_ = 0;
+  int lost_frames_ = 0, failures_ = 0, inliers_ = 0;
+};
+
+}  // namespace hiveslam::core
