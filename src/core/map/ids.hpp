@@ -20,4 +20,13 @@ class IdGenerator {
   std::atomic<uint64_t> counter_{0};
 };
 
+// Orders keyframes or map points by id, never by address: containers iterated by the SLAM
+// modules must visit elements in the same order on every run (the sequential mode's promise).
+struct ById {
+  template <typename T>
+  bool operator()(const T* a, const T* b) const {
+    return a->id < b->id;
+  }
+};
+
 }  // namespace hiveslam::core

@@ -17,7 +17,7 @@ std::vector<KeyFrame*> KeyFrame::bestCovisible(size_t n) const {
 }
 
 void KeyFrame::updateConnections() {
-  std::map<KeyFrame*, int> counts;
+  std::map<KeyFrame*, int, ById> counts;
   for (const auto& p : points) {
     if (!p || p->bad) continue;
     for (const auto& [kf, idx] : p->observations)

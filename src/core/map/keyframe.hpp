@@ -24,9 +24,9 @@ class KeyFrame : public std::enable_shared_from_this<KeyFrame> {
   const Frame frame;
   Eigen::Isometry3d T_cw;
   std::vector<std::shared_ptr<MapPoint>> points;  // per keypoint, null when unmatched
-  std::map<KeyFrame*, int> covisibility;          // keyframe -> shared points (>= 15 kept)
+  std::map<KeyFrame*, int, ById> covisibility;          // keyframe -> shared points (>= 15 kept)
   KeyFrame* parent = nullptr;
-  std::set<KeyFrame*> children;
+  std::set<KeyFrame*, ById> children;
   bool bad = false;
 
   Eigen::Vector3d center() const { return T_cw.inverse().translation(); }

@@ -19,7 +19,7 @@ class MapPoint {
   const Id id;
   Eigen::Vector3d position;
   const Id first_keyframe;
-  std::map<KeyFrame*, int> observations;  // keyframe -> keypoint index
+  std::map<KeyFrame*, int, ById> observations;  // keyframe -> keypoint index
   cv::Mat descriptor;                     // 1x32, the observation descriptor closest to the others
   Eigen::Vector3d normal = Eigen::Vector3d::Zero();  // mean viewing direction
   double min_distance = 0, max_distance = 0;         // scale-invariance range

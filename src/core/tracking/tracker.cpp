@@ -240,7 +240,7 @@ bool Tracker::trackReferenceKeyframe(Tracked& c) {
 
 bool Tracker::trackLocalMap(Tracked& c, int min_inliers) {
   // Local keyframes: those seeing the current matches, plus their best covisible neighbours.
-  std::map<KeyFrame*, int> votes;
+  std::map<KeyFrame*, int, ById> votes;
   for (size_t i = 0; i < c.points.size(); ++i)
     if (c.points[i] && !c.outlier[i] && !c.points[i]->bad)
       for (const auto& [kf, idx] : c.points[i]->observations) ++votes[kf];
