@@ -1,4 +1,5 @@
 // hiveslam: one program for every node and every tool; see `hiveslam --help`.
+#include <glog/logging.h>
 #include <spdlog/spdlog.h>
 
 #include <cstdio>
@@ -9,6 +10,9 @@
 
 int main(int argc, char** argv) {
   cv::utils::logging::setLogLevel(cv::utils::logging::LOG_LEVEL_ERROR);
+  // Ceres logs through glog; its warnings (a rejected LM step) are routine, not for users.
+  FLAGS_minloglevel = google::GLOG_ERROR;
+  google::InitGoogleLogging(argv[0]);
   CLI::App app{"hiveslam: self-organizing distributed monocular visual SLAM"};
   app.require_subcommand(1);
   app.set_version_flag("--version", "hiveslam 0.1.0");

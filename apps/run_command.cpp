@@ -14,6 +14,7 @@
 #include "eval/trajectory_error.hpp"
 #include "eval/trajectory_plot.hpp"
 #include "io/open_dataset.hpp"
+#include "io/slam_settings_io.hpp"
 #include "io/trajectory_io.hpp"
 
 namespace hiveslam::apps {
@@ -22,7 +23,8 @@ namespace {
 
 struct RunOptions {
   std::string dataset, config, times, out;
-  bool sequential = true;
+  bool sequential = false;
+  bool verbose = false;
   int max_frames = 0;
 };
 
@@ -43,15 +45,22 @@ void run(const RunOptions& o) {
   fmt::print(stderr, "{}\n", source->describe());
 
   core::SlamSettings settings;
-  core::SlamSystem slam(settings, source->camera().camera);
+  if (!o.config.empty()) io::applySlamSettings(o.config, settings);
+  core::SlamSystem slam(settings, source->camera().camera, o.sequential);
   Progress progress("tracking");
   const int total = static_cast<int>(source->size().value_or(0));
   int n = 0;
   while (auto frame = source->next()) {
-    slam.process(frame->image, frame->timestamp);
-    progress.update(++n, std::max(total, n));
+    const auto& r = slam.process(frame->image, frame->timestamp);
+    if (o.verbose)
+      fmt::print(stderr, "frame {} t {:.3f} {} inliers {} {}\n", r.index, r.timestamp, r.tracked ? "tracked" : "LOST",
+                 r.inliers, r.keyframe ? "keyframe" : "");
+    else
+      progress.update(++n, std::max(total, n));
+    if (o.verbose) ++n;
     if (o.max_frames > 0 && n >= o.max_frames) break;
   }
+  slam.finish();
 
   // Trajectory: every tracked frame of the largest map, through its reference keyframe.
   io::Trajectory estimate, keyframes;
@@ -129,6 +138,7 @@ void addRunCommand(CLI::App& app) {
   cmd->add_option("--out", o->out, "Output folder")->required();
   cmd->add_flag("--sequential", o->sequential, "Lockstep tracking and mapping on one thread (deterministic)");
   cmd->add_option("--max-frames", o->max_frames, "Stop after this many frames");
+  cmd->add_flag("--verbose", o->verbose, "One line per frame instead of the progress line");
   cmd->callback([o]() { run(*o); });
 }
 

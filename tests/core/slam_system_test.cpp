@@ -16,7 +16,7 @@ struct SlamRun {
 };
 
 // Frames [first, first + count) of a sequence of `total` frames (its speed set by `total`).
-SlamRun runSequence(const std::string& trajectory, int total, int first, int count, uint64_t seed) {
+SlamRun runSequence(const std::string& trajectory, int total, int first, int count, uint64_t seed, bool sequential) {
   synth::SequenceOptions o;
   o.trajectory = trajectory;
   o.frames = total;
@@ -25,12 +25,13 @@ SlamRun runSequence(const std::string& trajectory, int total, int first, int cou
   const synth::RayTable rays(model.lens);
   auto camera = std::make_shared<camera::PinholeRadTan>(model.lens.width, model.lens.height, model.lens.fx,
                                                         model.lens.fy, model.lens.cx, model.lens.cy);
-  SlamSystem slam(SlamSettings{}, camera);
+  SlamSystem slam(SlamSettings{}, camera, sequential);
   SlamRun run;
   for (int f = first; f < first + count; ++f) {
     slam.process(model.renderImage(f, rays), model.stamp(f));
     run.truth.add(model.stamp(f), model.pose(f));
   }
+  slam.finish();
   const auto map = slam.largestMap();
   for (const auto& r : slam.frames()) {
     ++run.frames;
@@ -41,15 +42,16 @@ SlamRun runSequence(const std::string& trajectory, int total, int first, int cou
   return run;
 }
 
+// Threaded: tracking on this thread, local mapping on its own.
 TEST(SlamSystem, TracksARenderedLoopAccurately) {
-  const SlamRun run = runSequence("loop", 400, 0, 250, 1);
+  const SlamRun run = runSequence("loop", 400, 0, 250, 1, false);
   EXPECT_GE(run.tracked, 0.9 * run.frames);
   const auto ate = eval::computeAte(run.truth, run.estimate);
   EXPECT_LT(ate.stats.rmse, 0.01 * ate.reference_length) << ate.stats.rmse << " m over " << ate.reference_length;
 }
 
 TEST(SlamSystem, SequentialModeIsDeterministic) {
-  const SlamRun a = runSequence("sweep", 600, 100, 80, 4), b = runSequence("sweep", 600, 100, 80, 4);
+  const SlamRun a = runSequence("sweep", 600, 100, 80, 4, true), b = runSequence("sweep", 600, 100, 80, 4, true);
   ASSERT_EQ(a.estimate.size(), b.estimate.size());
   ASSERT_GT(a.estimate.size(), 40u);
   for (size_t i = 0; i < a.estimate.size(); ++i)

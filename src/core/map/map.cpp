@@ -11,7 +11,10 @@ void Map::erase(MapPoint& p) {
   p.bad = true;
   for (const auto& [kf, idx] : p.observations) kf->points[static_cast<size_t>(idx)].reset();
   p.observations.clear();
-  points.erase(p.id);
+  if (auto it = points.find(p.id); it != points.end()) {
+    erased_points.push_back(it->second);
+    points.erase(it);
+  }
 }
 
 void Map::replace(MapPoint& old, const std::shared_ptr<MapPoint>& by) {
@@ -27,7 +30,10 @@ void Map::replace(MapPoint& old, const std::shared_ptr<MapPoint>& by) {
   by->found += old.found;
   old.observations.clear();
   old.bad = true;
-  points.erase(old.id);
+  if (auto it = points.find(old.id); it != points.end()) {
+    erased_points.push_back(it->second);
+    points.erase(it);
+  }
 }
 
 void Map::erase(KeyFrame& kf) {

@@ -25,6 +25,10 @@ class Map {
   KeyFrame* origin = nullptr;  // the first keyframe, fixed in optimizations
   // Culled keyframes stay alive (frames keep poses relative to them) but leave the map.
   std::vector<std::shared_ptr<KeyFrame>> retired;
+  // Erased points stay alive until the next collectGarbage(): a module may still hold a plain
+  // pointer or reference to one within the step that erased it.
+  std::vector<std::shared_ptr<MapPoint>> erased_points;
+  void collectGarbage() { erased_points.clear(); }
 
   void add(const std::shared_ptr<KeyFrame>& kf) { keyframes[kf->id] = kf; }
   void add(const std::shared_ptr<MapPoint>& p) { points[p->id] = p; }

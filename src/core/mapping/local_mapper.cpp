@@ -23,14 +23,32 @@ Eigen::Matrix3d skew(const Eigen::Vector3d& v) {
 LocalMapper::LocalMapper(const SlamSettings& settings, IdGenerator& ids, std::vector<double> scales)
     : settings_(settings), ids_(ids), scales_(std::move(scales)) {}
 
+struct LocalMapper::LocalBa {
+  BaProblem problem;
+  std::vector<KeyFrame*> keyframes;  // the optimized ones, in problem.poses order
+  std::vector<MapPoint*> points;
+  std::vector<std::pair<KeyFrame*, MapPoint*>> observations;
+  BaSummary summary;
+};
+
 void LocalMapper::process(const std::shared_ptr<Map>& map, const std::shared_ptr<KeyFrame>& kf,
                           const std::atomic<bool>* abort_ba) {
-  std::lock_guard lock(map->mutex);
+  std::unique_lock lock(map->mutex);
+  map->collectGarbage();
   insert(*map, *kf);
   cullRecentPoints(*map, *kf);
   triangulateNewPoints(*map, *kf);
   fuse(*map, *kf);
-  if (map->keyframes.size() > 2) localBundleAdjustment(*map, *kf, abort_ba);
+  if (map->keyframes.size() > 2) {
+    LocalBa ba = prepareLocalBa(*map, *kf);
+    lock.unlock();
+    BaOptions o;
+    o.iterations = settings_.local_ba_iterations;
+    o.abort = abort_ba;
+    ba.summary = bundleAdjust(ba.problem, o);
+    lock.lock();
+    applyLocalBa(*map, ba);
+  }
   cullKeyframes(*map, *kf);
   ++stats_.keyframes_processed;
 }
@@ -135,7 +153,8 @@ namespace {
 
 // Projects `points` into `kf` and merges each with the keypoint found there: observation added,
 // or the two points fused (the one with more observations survives).
-void fuseInto(Map& map, KeyFrame& kf, const std::vector<std::shared_ptr<MapPoint>>& points,
+// `points` is a copy: fusing rewrites keyframe slots, possibly the very vector it came from.
+void fuseInto(Map& map, KeyFrame& kf, std::vector<std::shared_ptr<MapPoint>> points,
               const std::vector<double>& scales) {
   const Eigen::Vector3d C = kf.center();
   for (const auto& p : points) {
@@ -186,7 +205,8 @@ void LocalMapper::fuse(Map& map, KeyFrame& kf) {
   kf.updateConnections();
 }
 
-void LocalMapper::localBundleAdjustment(Map& map, KeyFrame& kf, const std::atomic<bool>* abort) {
+LocalMapper::LocalBa LocalMapper::prepareLocalBa(Map& map, KeyFrame& kf) {
+  LocalBa out;
   std::vector<KeyFrame*> local{&kf};
   for (const auto& [n, w] : kf.covisibility)
     if (!n->bad) local.push_back(n);
@@ -231,27 +251,32 @@ void LocalMapper::localBundleAdjustment(Map& map, KeyFrame& kf, const std::atomi
       obs_refs.emplace_back(k, pts[i]);
     }
   }
-  BaOptions o;
-  o.iterations = settings_.local_ba_iterations;
-  o.abort = abort;
-  const BaSummary s = bundleAdjust(ba, o);
+  out.problem = std::move(ba);
+  out.keyframes = local;
+  out.points = std::move(pts);
+  out.observations = std::move(obs_refs);
+  return out;
+}
+
+void LocalMapper::applyLocalBa(Map& map, LocalBa& ba) {
   ++stats_.local_bas;
-  for (KeyFrame* k : local) {
-    const auto& pose = ba.poses[static_cast<size_t>(pose_index[k])];
-    k->T_cw.linear() = pose.q_cw.normalized().toRotationMatrix();
-    k->T_cw.translation() = pose.t_cw;
+  for (size_t k = 0; k < ba.keyframes.size(); ++k) {
+    const auto& pose = ba.problem.poses[k];
+    ba.keyframes[k]->T_cw.linear() = pose.q_cw.normalized().toRotationMatrix();
+    ba.keyframes[k]->T_cw.translation() = pose.t_cw;
   }
-  for (size_t i = 0; i < pts.size(); ++i) pts[i]->position = ba.points[i].p_w;
-  for (size_t i = 0; i < obs_refs.size(); ++i) {
-    if (!s.outlier[i]) continue;
-    auto [k, p] = obs_refs[i];
+  for (size_t i = 0; i < ba.points.size(); ++i)
+    if (!ba.points[i]->bad) ba.points[i]->position = ba.problem.points[i].p_w;
+  for (size_t i = 0; i < ba.observations.size(); ++i) {
+    if (!ba.summary.outlier[i]) continue;
+    auto [k, p] = ba.observations[i];
     auto it = p->observations.find(k);
     if (it == p->observations.end()) continue;
     k->points[static_cast<size_t>(it->second)].reset();
     p->observations.erase(it);
     if (p->observations.size() < 2 && !p->bad) map.erase(*p);
   }
-  for (MapPoint* p : pts)
+  for (MapPoint* p : ba.points)
     if (!p->bad) p->update(scales_);
 }
 

@@ -30,7 +30,11 @@ class LocalMapper {
   void cullRecentPoints(Map& map, const KeyFrame& kf);
   void triangulateNewPoints(Map& map, KeyFrame& kf);
   void fuse(Map& map, KeyFrame& kf);
-  void localBundleAdjustment(Map& map, KeyFrame& kf, const std::atomic<bool>* abort);
+  // Local BA in three steps so that the solve runs without the map lock: tracking keeps going
+  // while it optimizes copies of the poses and points.
+  struct LocalBa;
+  LocalBa prepareLocalBa(Map& map, KeyFrame& kf);
+  void applyLocalBa(Map& map, LocalBa& ba);
   void cullKeyframes(Map& map, KeyFrame& kf);
 
   SlamSettings settings_;

@@ -4,29 +4,59 @@
 
 namespace hiveslam::core {
 
-SlamSystem::SlamSystem(const SlamSettings& settings, std::shared_ptr<const camera::CameraModel> camera, uint16_t node)
+SlamSystem::SlamSystem(const SlamSettings& settings, std::shared_ptr<const camera::CameraModel> camera, bool sequential,
+                       uint16_t node)
     : settings_(settings),
       camera_(std::move(camera)),
       ids_(node),
       extractor_(settings.orb),
       tracker_(settings, ids_, extractor_.scales()),
-      mapper_(settings, ids_, extractor_.scales()) {}
+      mapper_(settings, ids_, extractor_.scales()),
+      sequential_(sequential) {
+  if (!sequential_) mapping_thread_ = std::thread([this] { mappingLoop(); });
+}
+
+SlamSystem::~SlamSystem() { finish(); }
+
+void SlamSystem::finish() {
+  jobs_.close();
+  if (mapping_thread_.joinable()) mapping_thread_.join();
+}
+
+void SlamSystem::mappingLoop() {
+  while (auto job = jobs_.pop()) {
+    mapping_busy_ = true;
+    abort_ba_ = jobs_.size() > 0;  // already a newer keyframe waiting: keep the BA short
+    mapper_.process(job->map, job->keyframe, &abort_ba_);
+    mapping_busy_ = false;
+  }
+}
 
 const FrameRecord& SlamSystem::process(const cv::Mat& gray, double timestamp) {
   const auto t0 = std::chrono::steady_clock::now();
   FrameRecord r;
   r.index = records_.size();
   r.timestamp = timestamp;
-  TrackingOutput out = tracker_.track(makeFrame(gray, r.index, timestamp, extractor_, *camera_), true);
+  const bool idle = sequential_ || (!mapping_busy_ && jobs_.size() == 0);
+  TrackingOutput out = tracker_.track(makeFrame(gray, r.index, timestamp, extractor_, *camera_), idle);
   r.tracking_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   if (out.new_map) maps_.push_back(out.new_map);
+  r.inliers = out.inliers;
+  r.keyframe = out.new_keyframe != nullptr;
   if (out.tracked && out.reference) {
     r.tracked = true;
     r.reference = out.reference;
-    r.T_c_ref = out.T_cw * out.reference->T_cw.inverse();
+    r.T_c_ref = out.T_c_ref;
     r.map = tracker_.map()->id;
   }
-  if (out.new_keyframe) mapper_.process(tracker_.map(), out.new_keyframe);
+  if (out.new_keyframe) {
+    if (sequential_) {
+      mapper_.process(tracker_.map(), out.new_keyframe);
+    } else {
+      abort_ba_ = true;  // a newer keyframe: the running local BA stops early
+      jobs_.push({tracker_.map(), out.new_keyframe});
+    }
+  }
   records_.push_back(std::move(r));
   return records_.back();
 }

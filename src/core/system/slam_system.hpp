@@ -1,9 +1,14 @@
 #pragma once
-// The SLAM system of one node: tracking and local mapping behind one call per frame. This is
-// the sequential (lockstep) composition: each frame is tracked, then its keyframe, if any, is
-// mapped before the next frame, so the same input always gives the same trajectory.
+// The SLAM system of one node: tracking and local mapping behind one call per frame.
+// Threaded (default): tracking runs on the caller's thread and hands keyframes to the local
+// mapping thread through a queue. Sequential: each frame is tracked, then its keyframe, if any,
+// is mapped before the next frame, so the same input always gives the same trajectory.
+#include <atomic>
 #include <memory>
+#include <thread>
 #include <vector>
+
+#include "common/blocking_queue.hpp"
 
 #include "core/camera/camera_model.hpp"
 #include "core/mapping/local_mapper.hpp"
@@ -19,14 +24,24 @@ struct FrameRecord {
   Eigen::Isometry3d T_c_ref = Eigen::Isometry3d::Identity();  // pose relative to the reference
   Id map = kNoId;
   double tracking_ms = 0;
+  int inliers = 0;       // map points tracked
+  bool keyframe = false;  // the frame became a keyframe
 };
 
 class SlamSystem {
  public:
-  SlamSystem(const SlamSettings& settings, std::shared_ptr<const camera::CameraModel> camera, uint16_t node = 0);
+  SlamSystem(const SlamSettings& settings, std::shared_ptr<const camera::CameraModel> camera, bool sequential,
+             uint16_t node = 0);
+  ~SlamSystem();
+  SlamSystem(const SlamSystem&) = delete;
+  SlamSystem& operator=(const SlamSystem&) = delete;
 
   // Tracks one grey image (and maps its keyframe); returns the frame's record.
   const FrameRecord& process(const cv::Mat& gray, double timestamp);
+
+  // Lets local mapping finish every queued keyframe and stops its thread (idempotent). Results
+  // are read after it.
+  void finish();
 
   const std::vector<FrameRecord>& frames() const { return records_; }
   const std::vector<std::shared_ptr<Map>>& maps() const { return maps_; }
@@ -47,6 +62,17 @@ class SlamSystem {
   LocalMapper mapper_;
   std::vector<std::shared_ptr<Map>> maps_;
   std::vector<FrameRecord> records_;
+
+  struct MappingJob {
+    std::shared_ptr<Map> map;
+    std::shared_ptr<KeyFrame> keyframe;
+  };
+  void mappingLoop();
+  bool sequential_;
+  BlockingQueue<MappingJob> jobs_;
+  std::atomic<bool> mapping_busy_{false};
+  std::atomic<bool> abort_ba_{false};
+  std::thread mapping_thread_;
 };
 
 }  // namespace hiveslam::core

@@ -80,6 +80,7 @@ TrackingOutput Tracker::track(Frame frame, bool mapping_idle) {
     last_keyframe_frame_ = current.frame.index;
   }
   out.reference = reference_;
+  out.T_c_ref = current.T_cw * reference_->T_cw.inverse();
   out.state = state_;
   // Outliers do not go forward to the next frame's matching.
   for (size_t i = 0; i < current.points.size(); ++i)
@@ -120,7 +121,8 @@ bool Tracker::initialize(Tracked& current, TrackingOutput& out) {
   const TwoViewResult r = initializeTwoView(p1, p2, f1.K, o);
   if (!r.ok) return false;
 
-  // The new map: two keyframes, the triangulated points, a full BA, median depth 1.
+  // The new map: two keyframes, the triangulated points, a full BA, median depth 1. (Points
+  // erased here stay alive in map->erased_points until local mapping collects them.)
   auto map = std::make_shared<Map>(ids_.next());
   auto kf1 = std::make_shared<KeyFrame>(ids_.next(), f1, Eigen::Isometry3d::Identity());
   auto kf2 = std::make_shared<KeyFrame>(ids_.next(), f2, r.T_21);
@@ -192,6 +194,7 @@ bool Tracker::initialize(Tracked& current, TrackingOutput& out) {
   out.new_keyframe = kf2;
   out.reference = kf2;
   out.T_cw = kf2->T_cw;
+  out.T_c_ref = Eigen::Isometry3d::Identity();
   out.inliers = static_cast<int>(map->points.size());
   return true;
 }

@@ -19,6 +19,7 @@ struct TrackingOutput {
   bool tracked = false;
   Eigen::Isometry3d T_cw = Eigen::Isometry3d::Identity();
   std::shared_ptr<KeyFrame> reference;      // the pose is kept relative to it
+  Eigen::Isometry3d T_c_ref = Eigen::Isometry3d::Identity();  // taken under the map lock
   std::shared_ptr<KeyFrame> new_keyframe;   // for local mapping (also the initial two)
   std::shared_ptr<Map> new_map;             // set when initialization created a map
   int inliers = 0;

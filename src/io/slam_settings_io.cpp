@@ -1,0 +1,75 @@
+#include "io/slam_settings_io.hpp"
+
+#include <yaml-cpp/yaml.h>
+
+#include <functional>
+#include <map>
+
+#include "common/error.hpp"
+
+namespace hiveslam::io {
+
+namespace {
+
+template <typename T>
+std::function<void(const YAML::Node&)> set(T& field) {
+  return [&field](const YAML::Node& n) { field = n.as<T>(); };
+}
+
+}  // namespace
+
+void applySlamSettings(const std::filesystem::path& file, core::SlamSettings& s) {
+  YAML::Node root;
+  try {
+    root = YAML::LoadFile(file.string());
+  } catch (const YAML::Exception& e) {
+    throw InputError(file.string() + ": " + e.msg);
+  }
+  const YAML::Node slam = root["slam"];
+  if (!slam) return;
+  const std::map<std::string, std::function<void(const YAML::Node&)>> keys{
+      {"init_min_matches", set(s.init_min_matches)},
+      {"init_min_parallax_deg", set(s.init_min_parallax_deg)},
+      {"init_min_points", set(s.init_min_points)},
+      {"search_radius_last_frame", set(s.search_radius_last_frame)},
+      {"min_matches_last_frame", set(s.min_matches_last_frame)},
+      {"min_inliers_tracking", set(s.min_inliers_tracking)},
+      {"min_inliers_after_relocalization", set(s.min_inliers_after_relocalization)},
+      {"local_keyframes", set(s.local_keyframes)},
+      {"keyframe_min_frames", set(s.keyframe_min_frames)},
+      {"keyframe_max_frames", set(s.keyframe_max_frames)},
+      {"keyframe_ratio", set(s.keyframe_ratio)},
+      {"keyframe_min_inliers", set(s.keyframe_min_inliers)},
+      {"lost_frames_before_new_map", set(s.lost_frames_before_new_map)},
+      {"triangulation_neighbours", set(s.triangulation_neighbours)},
+      {"fusion_neighbours", set(s.fusion_neighbours)},
+      {"local_ba_iterations", set(s.local_ba_iterations)},
+      {"redundant_keyframe_ratio", set(s.redundant_keyframe_ratio)},
+      {"seed", set(s.seed)},
+  };
+  const std::map<std::string, std::function<void(const YAML::Node&)>> orb_keys{
+      {"features", set(s.orb.features)},
+      {"scale_factor", set(s.orb.scale_factor)},
+      {"levels", set(s.orb.levels)},
+      {"fast_threshold", set(s.orb.fast_threshold)},
+      {"min_fast_threshold", set(s.orb.min_fast_threshold)},
+      {"cell_size", set(s.orb.cell_size)},
+  };
+  auto apply = [&](const YAML::Node& section, const auto& table, const std::string& prefix) {
+    for (const auto& kv : section) {
+      const std::string key = kv.first.as<std::string>();
+      if (prefix.empty() && key == "orb") continue;
+      const auto it = table.find(key);
+      if (it == table.end()) throw InputError(file.string() + ": unknown setting '" + prefix + key + "'");
+      try {
+        it->second(kv.second);
+      } catch (const YAML::Exception&) {
+        throw InputError(file.string() + ": setting '" + prefix + key + "' has the wrong type");
+      }
+    }
+  };
+  apply(slam, keys, "");
+  if (slam["orb"]) apply(slam["orb"], orb_keys, "orb.");
+}
+
+}  // namespace hiveslam::io
