@@ -55,7 +55,7 @@ TrackingOutput Tracker::track(Frame frame, bool mapping_idle) {
     ++lost_frames_;
     // A young map that loses track is abandoned at once; an established one gets a few frames
     // to relocalize before a new map is started.
-    if (map_->keyframes.size() <= 5 || lost_frames_ > settings_.lost_frames_before_new_map) {
+    if (keyframes_made_ <= 5 || lost_frames_ > settings_.lost_frames_before_new_map) {
       lock.unlock();
       state_ = TrackingState::NotInitialized;
       init_reference_.reset();
@@ -76,6 +76,7 @@ TrackingOutput Tracker::track(Frame frame, bool mapping_idle) {
   out.inliers = inliers_;
   if (needKeyframe(current, mapping_idle)) {
     out.new_keyframe = makeKeyframe(current);
+    ++keyframes_made_;
     reference_ = out.new_keyframe;
     last_keyframe_frame_ = current.frame.index;
   }
@@ -182,6 +183,7 @@ bool Tracker::initialize(Tracked& current, TrackingOutput& out) {
     p->update(scales_);
   }
   map_ = map;
+  keyframes_made_ = 2;
   reference_ = kf2;
   current.T_cw = kf2->T_cw;
   current.points = kf2->points;
@@ -347,9 +349,9 @@ bool Tracker::needKeyframe(const Tracked& c, bool mapping_idle) const {
   const size_t since = c.frame.index - last_keyframe_frame_;
   if (since < static_cast<size_t>(settings_.keyframe_min_frames)) return false;
   if (c.frame.index < last_relocalization_frame_ + static_cast<size_t>(settings_.keyframe_max_frames) &&
-      map_->keyframes.size() > static_cast<size_t>(settings_.keyframe_max_frames))
+      keyframes_made_ > settings_.keyframe_max_frames)
     return false;
-  const int reference_points = reference_ ? reference_->trackedPoints(map_->keyframes.size() <= 2 ? 2 : 3) : 0;
+  const int reference_points = reference_ ? reference_->trackedPoints(keyframes_made_ <= 2 ? 2 : 3) : 0;
   const bool timely = since >= static_cast<size_t>(settings_.keyframe_max_frames) || mapping_idle;
   const bool weak = inliers_ < settings_.keyframe_ratio * reference_points && inliers_ > settings_.keyframe_min_inliers;
   return timely && weak;

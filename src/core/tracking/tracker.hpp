@@ -65,6 +65,9 @@ class Tracker {
   bool have_velocity_ = false;
   size_t last_keyframe_frame_ = 0, last_relocalization_frame_ = 0;
   int lost_frames_ = 0, failures_ = 0, inliers_ = 0;
+  // Keyframes this tracker made for the current map: unlike the map's own count it does not lag
+  // behind a busy local mapping thread.
+  int keyframes_made_ = 0;
 };
 
 }  // namespace hiveslam::core
