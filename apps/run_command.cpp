@@ -3,7 +3,9 @@
 
 #include <algorithm>
 #include <filesystem>
+#include <chrono>
 #include <fstream>
+#include <thread>
 #include <nlohmann/json.hpp>
 
 #include "apps/commands.hpp"
@@ -25,6 +27,7 @@ struct RunOptions {
   std::string dataset, config, times, out;
   bool sequential = false;
   bool verbose = false;
+  bool realtime = false;
   int max_frames = 0;
 };
 
@@ -46,11 +49,31 @@ void run(const RunOptions& o) {
 
   core::SlamSettings settings;
   if (!o.config.empty()) io::applySlamSettings(o.config, settings);
-  core::SlamSystem slam(settings, source->camera().camera, o.sequential);
+  const auto mode = o.sequential ? core::SlamSystem::Mode::Sequential
+                    : o.realtime ? core::SlamSystem::Mode::Realtime
+                                 : core::SlamSystem::Mode::Offline;
+  core::SlamSystem slam(settings, source->camera().camera, mode);
   Progress progress("tracking");
   const int total = static_cast<int>(source->size().value_or(0));
-  int n = 0;
+  int n = 0, dropped = 0;
+  const auto wall_start = std::chrono::steady_clock::now();
+  double first_stamp = -1, last_stamp = -1;
   while (auto frame = source->next()) {
+    if (o.realtime) {
+      // A camera does not wait: a frame whose time has passed by more than a frame period
+      // while the previous one was processed is dropped.
+      if (first_stamp < 0) first_stamp = frame->timestamp;
+      const double period = last_stamp < 0 ? 0.05 : frame->timestamp - last_stamp;
+      last_stamp = frame->timestamp;
+      const auto due = wall_start + std::chrono::duration<double>(frame->timestamp - first_stamp);
+      const auto now = std::chrono::steady_clock::now();
+      if (now > due + std::chrono::duration<double>(period)) {
+        ++dropped;
+        ++n;
+        continue;
+      }
+      std::this_thread::sleep_until(due);
+    }
     const auto& r = slam.process(frame->image, frame->timestamp);
     if (o.verbose)
       fmt::print(stderr, "frame {} t {:.3f} {} inliers {} {}\n", r.index, r.timestamp, r.tracked ? "tracked" : "LOST",
@@ -91,6 +114,8 @@ void run(const RunOptions& o) {
   report["failures"] = slam.failures();
   report["keyframes"] = keyframe_count;
   report["maps"] = slam.maps().size();
+  report["mode"] = o.sequential ? "sequential" : o.realtime ? "realtime" : "offline";
+  if (o.realtime) report["dropped_frames"] = dropped;
   report["cpu_seconds"] = monitor.cpuSeconds();
   report["wall_seconds"] = monitor.wallSeconds();
   report["cpu_percent"] = monitor.cpuPercent();
@@ -137,6 +162,7 @@ void addRunCommand(CLI::App& app) {
   cmd->add_option("--times", o->times, "Times file for image folders and videos");
   cmd->add_option("--out", o->out, "Output folder")->required();
   cmd->add_flag("--sequential", o->sequential, "Lockstep tracking and mapping on one thread (deterministic)");
+  cmd->add_flag("--realtime", o->realtime, "Feed frames at their timestamps; tracking never waits for mapping");
   cmd->add_option("--max-frames", o->max_frames, "Stop after this many frames");
   cmd->add_flag("--verbose", o->verbose, "One line per frame instead of the progress line");
   cmd->callback([o]() { run(*o); });

@@ -16,7 +16,7 @@ struct SlamRun {
 };
 
 // Frames [first, first + count) of a sequence of `total` frames (its speed set by `total`).
-SlamRun runSequence(const std::string& trajectory, int total, int first, int count, uint64_t seed, bool sequential) {
+SlamRun runSequence(const std::string& trajectory, int total, int first, int count, uint64_t seed, SlamSystem::Mode mode) {
   synth::SequenceOptions o;
   o.trajectory = trajectory;
   o.frames = total;
@@ -25,7 +25,7 @@ SlamRun runSequence(const std::string& trajectory, int total, int first, int cou
   const synth::RayTable rays(model.lens);
   auto camera = std::make_shared<camera::PinholeRadTan>(model.lens.width, model.lens.height, model.lens.fx,
                                                         model.lens.fy, model.lens.cx, model.lens.cy);
-  SlamSystem slam(SlamSettings{}, camera, sequential);
+  SlamSystem slam(SlamSettings{}, camera, mode);
   SlamRun run;
   for (int f = first; f < first + count; ++f) {
     slam.process(model.renderImage(f, rays), model.stamp(f));
@@ -43,7 +43,7 @@ SlamRun runSequence(const std::string& trajectory, int total, int first, int cou
 }
 
 TEST(SlamSystem, TracksARenderedLoopAccurately) {
-  const SlamRun run = runSequence("loop", 400, 0, 250, 1, true);
+  const SlamRun run = runSequence("loop", 400, 0, 250, 1, SlamSystem::Mode::Sequential);
   EXPECT_GE(run.tracked, 0.9 * run.frames);
   const auto ate = eval::computeAte(run.truth, run.estimate);
   EXPECT_LT(ate.stats.rmse, 0.01 * ate.reference_length) << ate.stats.rmse << " m over " << ate.reference_length;
@@ -52,14 +52,14 @@ TEST(SlamSystem, TracksARenderedLoopAccurately) {
 // Threaded: tracking on this thread, local mapping on its own. Thread timing varies with the
 // machine's load, so the bar is lower than the deterministic run's; TSan runs this test too.
 TEST(SlamSystem, ThreadedModeTracks) {
-  const SlamRun run = runSequence("loop", 400, 0, 250, 1, false);
+  const SlamRun run = runSequence("loop", 400, 0, 250, 1, SlamSystem::Mode::Offline);
   EXPECT_GE(run.tracked, 0.8 * run.frames);
   const auto ate = eval::computeAte(run.truth, run.estimate);
   EXPECT_LT(ate.stats.rmse, 0.02 * ate.reference_length) << ate.stats.rmse << " m over " << ate.reference_length;
 }
 
 TEST(SlamSystem, SequentialModeIsDeterministic) {
-  const SlamRun a = runSequence("sweep", 600, 100, 80, 4, true), b = runSequence("sweep", 600, 100, 80, 4, true);
+  const SlamRun a = runSequence("sweep", 600, 100, 80, 4, SlamSystem::Mode::Sequential), b = runSequence("sweep", 600, 100, 80, 4, SlamSystem::Mode::Sequential);
   ASSERT_EQ(a.estimate.size(), b.estimate.size());
   ASSERT_GT(a.estimate.size(), 40u);
   for (size_t i = 0; i < a.estimate.size(); ++i)

@@ -95,7 +95,7 @@ void expectRecovered(const Views& v) {
   EXPECT_LT(rel[rel.size() / 2], 0.03);
 }
 
-TEST(TwoView, RecoversMotionOnTheLoop) { expectRecovered(render("loop", 100, 115, 1)); }
+TEST(TwoView, RecoversMotionOnTheLoop) { expectRecovered(render("loop", 100, 118, 1)); }
 TEST(TwoView, RecoversMotionOnTheSweep) { expectRecovered(render("sweep", 300, 316, 4)); }
 
 TEST(TwoView, RefusesPureRotation) {

@@ -146,21 +146,39 @@ void OrbExtractor::extract(const cv::Mat& gray, std::vector<cv::KeyPoint>& keypo
     }
     cv::Mat padded;
     cv::copyMakeBorder(level_img, padded, kBorder, kBorder, kBorder, kBorder, cv::BORDER_REFLECT_101);
-    // FAST per cell over the image (3 px margin for the FAST circle), adaptive threshold.
+    // FAST over the whole level at the first threshold (one call, no per-cell overhead), then
+    // again at the lower threshold in the cells where it found nothing: the adaptive threshold.
     std::vector<cv::KeyPoint> found;
     const int W = level_img.cols, H = level_img.rows, cs = options_.cell_size;
-    for (int y0 = 0; y0 < H; y0 += cs)
-      for (int x0 = 0; x0 < W; x0 += cs) {
+    const int cols = (W + cs - 1) / cs, rows = (H + cs - 1) / cs;
+    std::vector<int> per_cell(static_cast<size_t>(cols * rows), 0);
+    auto keep = [&](cv::KeyPoint kp, float dx, float dy) {
+      kp.pt.x += dx;
+      kp.pt.y += dy;
+      if (kp.pt.x < 0 || kp.pt.y < 0 || kp.pt.x > W - 1 || kp.pt.y > H - 1) return;
+      ++per_cell[static_cast<size_t>(static_cast<int>(kp.pt.y) / cs * cols + static_cast<int>(kp.pt.x) / cs)];
+      found.push_back(kp);
+    };
+    {
+      // 3 px margin for the FAST circle, taken from the reflected border.
+      const cv::Rect all(kBorder - 3, kBorder - 3, W + 6, H + 6);
+      std::vector<cv::KeyPoint> k;
+      cv::FAST(padded(all), k, options_.fast_threshold, true);
+      for (const auto& kp : k) keep(kp, -3.0f, -3.0f);
+    }
+    const std::vector<int> first_pass = per_cell;
+    for (int cy = 0; cy < rows; ++cy)
+      for (int cx = 0; cx < cols; ++cx) {
+        if (first_pass[static_cast<size_t>(cy * cols + cx)] > 0) continue;
+        const int x0 = cx * cs, y0 = cy * cs;
         const cv::Rect cell(x0 + kBorder - 3, y0 + kBorder - 3, std::min(cs, W - x0) + 6, std::min(cs, H - y0) + 6);
-        const cv::Mat roi = padded(cell);
         std::vector<cv::KeyPoint> k;
-        cv::FAST(roi, k, options_.fast_threshold, true);
-        if (k.empty()) cv::FAST(roi, k, options_.min_fast_threshold, true);
-        for (auto& kp : k) {
-          kp.pt.x += static_cast<float>(x0 - 3);
-          kp.pt.y += static_cast<float>(y0 - 3);
-          if (kp.pt.x < 0 || kp.pt.y < 0 || kp.pt.x > W - 1 || kp.pt.y > H - 1) continue;
-          found.push_back(kp);
+        cv::FAST(padded(cell), k, options_.min_fast_threshold, true);
+        for (const auto& kp : k) {
+          // Only corners inside this cell: its neighbours already have their own.
+          if (kp.pt.x - 3 < 0 || kp.pt.y - 3 < 0 || kp.pt.x - 3 >= std::min(cs, W - x0) || kp.pt.y - 3 >= std::min(cs, H - y0))
+            continue;
+          keep(kp, static_cast<float>(x0 - 3), static_cast<float>(y0 - 3));
         }
       }
     std::vector<cv::KeyPoint> kept = distribute(found, cv::Rect2f(0, 0, static_cast<float>(W), static_cast<float>(H)),

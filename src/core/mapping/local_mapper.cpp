@@ -4,6 +4,7 @@
 #include <set>
 
 #include "core/features/hamming.hpp"
+#include "core/features/rotation_histogram.hpp"
 #include "core/geometry/triangulation.hpp"
 #include "core/matching/projection_matcher.hpp"
 #include "core/optim/bundle_adjustment.hpp"
@@ -107,13 +108,17 @@ void LocalMapper::triangulateNewPoints(Map& map, KeyFrame& kf) {
     Eigen::Matrix3d Km;
     Km << K.fx, 0, K.cx, 0, K.fy, K.cy, 0, 0, 1;
     const Eigen::Matrix3d F21 = Km.inverse().transpose() * skew(T21.translation()) * T21.linear() * Km.inverse();
+    // Candidates along the epipolar band; without a vocabulary to narrow the search, the best
+    // must clearly beat the second best and the pair must agree with the dominant rotation.
     std::vector<int> taken(nb->points.size(), 0);
+    std::vector<std::pair<size_t, size_t>> pairs;
+    features::RotationHistogram hist;
     for (size_t i = 0; i < kf.points.size(); ++i) {
       if (kf.points[i]) continue;
       const Eigen::Vector3d l2 = F21 * kf.frame.points[i].homogeneous();
       const double norm2 = l2.head<2>().squaredNorm();
       const uchar* d1 = kf.frame.descriptors.ptr<uchar>(static_cast<int>(i));
-      int best = kMatchLow + 1, best_j = -1;
+      int best = 256, second = 256, best_j = -1;
       for (size_t j = 0; j < nb->points.size(); ++j) {
         if (nb->points[j] || taken[j]) continue;
         const double e = nb->frame.points[j].homogeneous().dot(l2);
@@ -121,11 +126,25 @@ void LocalMapper::triangulateNewPoints(Map& map, KeyFrame& kf) {
         if (e * e / norm2 > 3.84 * s2 * s2) continue;
         const int d = features::hamming(d1, nb->frame.descriptors.ptr<uchar>(static_cast<int>(j)));
         if (d < best) {
+          second = best;
           best = d;
           best_j = static_cast<int>(j);
+        } else if (d < second) {
+          second = d;
         }
       }
-      if (best_j < 0) continue;
+      if (best_j < 0 || best > kMatchLow || best >= 0.7 * second) continue;
+      taken[static_cast<size_t>(best_j)] = 1;
+      hist.add(kf.frame.keypoints[i].angle, nb->frame.keypoints[static_cast<size_t>(best_j)].angle,
+               static_cast<int>(pairs.size()));
+      pairs.emplace_back(i, static_cast<size_t>(best_j));
+    }
+    std::vector<bool> rejected(pairs.size(), false);
+    for (int k : hist.rejected()) rejected[static_cast<size_t>(k)] = true;
+    for (size_t k = 0; k < pairs.size(); ++k) {
+      if (rejected[k]) continue;
+      const size_t i = pairs[k].first;
+      const int best_j = static_cast<int>(pairs[k].second);
       const size_t j = static_cast<size_t>(best_j);
       const double s1 = scales_[static_cast<size_t>(kf.frame.keypoints[i].octave)];
       const double s2 = scales_[static_cast<size_t>(nb->frame.keypoints[j].octave)];
@@ -143,7 +162,6 @@ void LocalMapper::triangulateNewPoints(Map& map, KeyFrame& kf) {
       p->update(scales_);
       map.add(p);
       recent_.push_back({p, 0});
-      taken[j] = 1;
       ++stats_.points_created;
     }
   }

@@ -4,7 +4,7 @@
 
 namespace hiveslam::core {
 
-SlamSystem::SlamSystem(const SlamSettings& settings, std::shared_ptr<const camera::CameraModel> camera, bool sequential,
+SlamSystem::SlamSystem(const SlamSettings& settings, std::shared_ptr<const camera::CameraModel> camera, Mode mode,
                        uint16_t node)
     : settings_(settings),
       camera_(std::move(camera)),
@@ -12,8 +12,14 @@ SlamSystem::SlamSystem(const SlamSettings& settings, std::shared_ptr<const camer
       extractor_(settings.orb),
       tracker_(settings, ids_, extractor_.scales()),
       mapper_(settings, ids_, extractor_.scales()),
-      sequential_(sequential) {
-  if (!sequential_) mapping_thread_ = std::thread([this] { mappingLoop(); });
+      mode_(mode) {
+  if (mode_ != Mode::Sequential) mapping_thread_ = std::thread([this] { mappingLoop(); });
+  if (mode_ == Mode::Offline) tracker_.setWaitForMapping([this] { waitForMapping(); });
+}
+
+void SlamSystem::waitForMapping() {
+  std::unique_lock lock(idle_mutex_);
+  idle_cv_.wait(lock, [&] { return jobs_done_ == jobs_pushed_; });
 }
 
 SlamSystem::~SlamSystem() { finish(); }
@@ -29,6 +35,11 @@ void SlamSystem::mappingLoop() {
     abort_ba_ = jobs_.size() > 0;  // already a newer keyframe waiting: keep the BA short
     mapper_.process(job->map, job->keyframe, &abort_ba_);
     mapping_busy_ = false;
+    {
+      std::lock_guard lock(idle_mutex_);
+      ++jobs_done_;
+    }
+    idle_cv_.notify_all();
   }
 }
 
@@ -37,7 +48,7 @@ const FrameRecord& SlamSystem::process(const cv::Mat& gray, double timestamp) {
   FrameRecord r;
   r.index = records_.size();
   r.timestamp = timestamp;
-  const bool idle = sequential_ || (!mapping_busy_ && jobs_.size() == 0);
+  const bool idle = mode_ == Mode::Sequential || (!mapping_busy_ && jobs_.size() == 0);
   TrackingOutput out = tracker_.track(makeFrame(gray, r.index, timestamp, extractor_, *camera_), idle);
   r.tracking_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   if (out.new_map) maps_.push_back(out.new_map);
@@ -50,10 +61,14 @@ const FrameRecord& SlamSystem::process(const cv::Mat& gray, double timestamp) {
     r.map = tracker_.map()->id;
   }
   if (out.new_keyframe) {
-    if (sequential_) {
+    if (mode_ == Mode::Sequential) {
       mapper_.process(tracker_.map(), out.new_keyframe);
     } else {
       abort_ba_ = true;  // a newer keyframe: the running local BA stops early
+      {
+        std::lock_guard lock(idle_mutex_);
+        ++jobs_pushed_;
+      }
       jobs_.push({tracker_.map(), out.new_keyframe});
     }
   }

@@ -4,6 +4,8 @@
 // mapping thread through a queue. Sequential: each frame is tracked, then its keyframe, if any,
 // is mapped before the next frame, so the same input always gives the same trajectory.
 #include <atomic>
+#include <condition_variable>
+#include <mutex>
 #include <memory>
 #include <thread>
 #include <vector>
@@ -30,7 +32,12 @@ struct FrameRecord {
 
 class SlamSystem {
  public:
-  SlamSystem(const SlamSettings& settings, std::shared_ptr<const camera::CameraModel> camera, bool sequential,
+  enum class Mode {
+    Sequential,  // lockstep on the caller's thread: deterministic
+    Offline,     // threaded; tracking waits for mapping when a keyframe is due (full accuracy)
+    Realtime,    // threaded; tracking never waits (keyframes are skipped while mapping is busy)
+  };
+  SlamSystem(const SlamSettings& settings, std::shared_ptr<const camera::CameraModel> camera, Mode mode,
              uint16_t node = 0);
   ~SlamSystem();
   SlamSystem(const SlamSystem&) = delete;
@@ -68,9 +75,13 @@ class SlamSystem {
     std::shared_ptr<KeyFrame> keyframe;
   };
   void mappingLoop();
-  bool sequential_;
+  void waitForMapping();
+  Mode mode_;
   BlockingQueue<MappingJob> jobs_;
   std::atomic<bool> mapping_busy_{false};
+  std::mutex idle_mutex_;
+  std::condition_variable idle_cv_;
+  size_t jobs_pushed_ = 0, jobs_done_ = 0;  // guarded by idle_mutex_
   std::atomic<bool> abort_ba_{false};
   std::thread mapping_thread_;
 };

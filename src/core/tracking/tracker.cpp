@@ -74,6 +74,16 @@ TrackingOutput Tracker::track(Frame frame, bool mapping_idle) {
   out.tracked = true;
   out.T_cw = current.T_cw;
   out.inliers = inliers_;
+  if (!mapping_idle && wait_for_mapping_ && keyframeWanted(current)) {
+    lock.unlock();
+    wait_for_mapping_();
+    lock.lock();
+    mapping_idle = true;
+    // Local BA may have moved the points this frame was tracked against: the keyframe must be
+    // posed in the map as it is now, or its new points are triangulated in a stale frame.
+    optimize(current);
+    out.T_cw = current.T_cw;
+  }
   if (needKeyframe(current, mapping_idle)) {
     out.new_keyframe = makeKeyframe(current);
     ++keyframes_made_;
@@ -345,16 +355,20 @@ bool Tracker::relocalize(Tracked& c) {
   return false;
 }
 
+bool Tracker::keyframeWanted(const Tracked& c) const {
+  if (c.frame.index - last_keyframe_frame_ < static_cast<size_t>(settings_.keyframe_min_frames)) return false;
+  const int reference_points = reference_ ? reference_->trackedPoints(keyframes_made_ <= 2 ? 2 : 3) : 0;
+  return inliers_ < settings_.keyframe_ratio * reference_points && inliers_ > settings_.keyframe_min_inliers;
+}
+
 bool Tracker::needKeyframe(const Tracked& c, bool mapping_idle) const {
   const size_t since = c.frame.index - last_keyframe_frame_;
   if (since < static_cast<size_t>(settings_.keyframe_min_frames)) return false;
   if (c.frame.index < last_relocalization_frame_ + static_cast<size_t>(settings_.keyframe_max_frames) &&
       keyframes_made_ > settings_.keyframe_max_frames)
     return false;
-  const int reference_points = reference_ ? reference_->trackedPoints(keyframes_made_ <= 2 ? 2 : 3) : 0;
   const bool timely = since >= static_cast<size_t>(settings_.keyframe_max_frames) || mapping_idle;
-  const bool weak = inliers_ < settings_.keyframe_ratio * reference_points && inliers_ > settings_.keyframe_min_inliers;
-  return timely && weak;
+  return timely && keyframeWanted(c);
 }
 
 std::shared_ptr<KeyFrame> Tracker::makeKeyframe(const Tracked& c) {

@@ -31,6 +31,10 @@ class Tracker {
 
   // mapping_idle: local mapping has no keyframe waiting (keyframe decision input).
   TrackingOutput track(Frame frame, bool mapping_idle);
+  // Offline runs (frames as fast as possible) set this: when a keyframe is due but local
+  // mapping is busy, tracking waits for it instead of skipping the keyframe, so the map keeps
+  // up with a camera that moves faster than real time. It is called without the map lock.
+  void setWaitForMapping(std::function<void()> wait) { wait_for_mapping_ = std::move(wait); }
   TrackingState state() const { return state_; }
   int failures() const { return failures_; }
   const std::shared_ptr<Map>& map() const { return map_; }
@@ -50,6 +54,7 @@ class Tracker {
   bool relocalize(Tracked& current);
   int optimize(Tracked& current);
   bool needKeyframe(const Tracked& current, bool mapping_idle) const;
+  bool keyframeWanted(const Tracked& current) const;  // the point-ratio half of the decision
   std::shared_ptr<KeyFrame> makeKeyframe(const Tracked& current);
 
   SlamSettings settings_;
@@ -68,6 +73,7 @@ class Tracker {
   // Keyframes this tracker made for the current map: unlike the map's own count it does not lag
   // behind a busy local mapping thread.
   int keyframes_made_ = 0;
+  std::function<void()> wait_for_mapping_;
 };
 
 }  // namespace hiveslam::core
