@@ -3,7 +3,9 @@
 #include <cmath>
 #include <opencv2/imgproc.hpp>
 
+#include "common/error.hpp"
 #include "io/open_dataset.hpp"
+#include <opencv2/imgcodecs.hpp>
 #include "synth/renderer.hpp"
 #include "synth/sequence.hpp"
 #include "synth/suite.hpp"
@@ -116,6 +118,30 @@ TEST_P(SuiteMotion, RealisticAndCollisionFree) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Standard, SuiteMotion, ::testing::Values("loop", "figure8", "blackout", "sweep"));
+
+TEST(Sequence, TexturesFromPhotos) {
+  testing::TempDir dir;
+  std::filesystem::create_directories(dir / "photos");
+  for (int i = 0; i < 2; ++i) {
+    cv::Mat photo(120, 160, CV_8U);
+    for (int y = 0; y < photo.rows; ++y)
+      for (int x = 0; x < photo.cols; ++x) photo.at<uchar>(y, x) = ((x / 20 + y / 20 + i) % 2) ? 220 : 30;
+    cv::imwrite((dir / "photos" / (std::to_string(i) + ".png")).string(), photo);
+  }
+  SequenceOptions o;
+  o.width = 96;
+  o.height = 64;
+  o.frames = 4;
+  o.noise = 0;
+  o.textures = (dir / "photos").string();
+  const SequenceModel m = buildSequence(o);
+  const cv::Mat img = m.renderImage(2, RayTable(m.lens));
+  cv::Scalar mean, stddev;
+  cv::meanStdDev(img, mean, stddev);
+  EXPECT_GT(stddev[0], 10.0);  // textured, not blank
+  o.textures = (dir / "missing").string();
+  EXPECT_THROW(buildSequence(o), InputError);
+}
 
 TEST(Sequence, WritesEurocLayout) {
   testing::TempDir dir;
