@@ -46,7 +46,9 @@ BaSummary bundleAdjust(BaProblem& pb, const BaOptions& o) {
     if (point.fixed && problem.HasParameterBlock(point.p_w.data())) problem.SetParameterBlockConstant(point.p_w.data());
 
   ceres::Solver::Options options;
-  options.linear_solver_type = ceres::SPARSE_SCHUR;
+  // Local windows have tens of poses: the dense Schur complement is fast there and keeps
+  // CHOLMOD (and its OpenMP threads) out of the mapping thread. Big problems go sparse.
+  options.linear_solver_type = pb.poses.size() <= 60 ? ceres::DENSE_SCHUR : ceres::SPARSE_SCHUR;
   options.max_num_iterations = o.iterations;
   options.num_threads = 1;
   options.logging_type = ceres::SILENT;
