@@ -9,6 +9,7 @@
 #include <nlohmann/json.hpp>
 
 #include "apps/commands.hpp"
+#include "apps/run_slam.hpp"
 #include "apps/progress.hpp"
 #include "common/error.hpp"
 #include "core/system/slam_system.hpp"
@@ -23,21 +24,15 @@ namespace hiveslam::apps {
 
 namespace {
 
-struct RunOptions {
-  std::string dataset, config, times, out;
-  bool sequential = false;
-  bool verbose = false;
-  bool realtime = false;
-  int max_frames = 0;
-};
-
 double percentile(std::vector<double> v, double q) {
   if (v.empty()) return 0;
   std::sort(v.begin(), v.end());
   return v[std::min(v.size() - 1, static_cast<size_t>(q * (v.size() - 1) + 0.5))];
 }
 
-void run(const RunOptions& o) {
+}  // namespace
+
+RunSummary runSlam(const RunOptions& o) {
   eval::ResourceMonitor monitor;
   io::DatasetOptions dataset_options;
   if (!o.config.empty()) dataset_options.settings = o.config;
@@ -147,12 +142,13 @@ void run(const RunOptions& o) {
     }
   }
   std::ofstream(out / "report.json") << report.dump(2) << "\n";
-  fmt::print("frames {} tracked {} ({:.1f}%) failures {} keyframes {} maps {} | {} | tracking median {:.1f} ms\n", n,
-             tracked, 100.0 * tracked / std::max(n, 1), slam.failures(), keyframe_count, slam.maps().size(), ate_line,
-             percentile(tracking_ms, 0.5));
+  RunSummary summary;
+  summary.report = report;
+  summary.line = fmt::format("frames {} tracked {} ({:.1f}%) failures {} keyframes {} maps {} | {} | tracking median {:.1f} ms",
+                             n, tracked, 100.0 * tracked / std::max(n, 1), slam.failures(), keyframe_count,
+                             slam.maps().size(), ate_line, percentile(tracking_ms, 0.5));
+  return summary;
 }
-
-}  // namespace
 
 void addRunCommand(CLI::App& app) {
   auto* cmd = app.add_subcommand("run", "Run standalone monocular SLAM on a dataset");
@@ -165,7 +161,7 @@ void addRunCommand(CLI::App& app) {
   cmd->add_flag("--realtime", o->realtime, "Feed frames at their timestamps; tracking never waits for mapping");
   cmd->add_option("--max-frames", o->max_frames, "Stop after this many frames");
   cmd->add_flag("--verbose", o->verbose, "One line per frame instead of the progress line");
-  cmd->callback([o]() { run(*o); });
+  cmd->callback([o]() { fmt::print("{}\n", runSlam(*o).line); });
 }
 
 }  // namespace hiveslam::apps
