@@ -1,51 +1,116 @@
 #include "core/optim/pose_optimizer.hpp"
 
-#include <ceres/ceres.h>
-
-#include "core/optim/reprojection_error.hpp"
+#include <Eigen/Cholesky>
+#include <cmath>
+#include <limits>
 
 namespace hiveslam::core {
+
+namespace {
+
+constexpr double kChi2 = 5.991;  // 95% of chi-square with 2 degrees of freedom
+constexpr int kRounds = 4;
+constexpr int kIterations = 10;
+
+Eigen::Matrix3d skew(const Eigen::Vector3d& v) {
+  Eigen::Matrix3d m;
+  m << 0, -v.z(), v.y(), v.z(), 0, -v.x(), -v.y(), v.x(), 0;
+  return m;
+}
+
+// exp of an se(3) twist (rotation first, then translation), enough for small steps.
+Eigen::Isometry3d expSE3(const Eigen::Matrix<double, 6, 1>& d) {
+  const Eigen::Vector3d w = d.head<3>();
+  const Eigen::Vector3d rho = d.tail<3>();
+  const double theta = w.norm();
+  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+  const Eigen::Matrix3d W = skew(w);
+  Eigen::Matrix3d V = Eigen::Matrix3d::Identity();
+  if (theta < 1e-10) {
+    T.linear() = Eigen::Matrix3d::Identity() + W;
+    V += 0.5 * W;
+  } else {
+    T.linear() = Eigen::AngleAxisd(theta, w / theta).toRotationMatrix();
+    const double t2 = theta * theta;
+    V += (1 - std::cos(theta)) / t2 * W + (theta - std::sin(theta)) / (t2 * theta) * W * W;
+  }
+  T.translation() = V * rho;
+  return T;
+}
+
+double chi2Of(const Intrinsics& K, const PoseObservation& o, const Eigen::Isometry3d& T) {
+  const Eigen::Vector3d pc = T * o.point;
+  if (pc.z() <= 0) return 1e9;
+  return ((K.project(pc) - o.uv) * o.inv_sigma).squaredNorm();
+}
+
+// One Gauss-Newton (IRLS) solve over the observations not flagged as outliers. With
+// `robust`, residuals beyond the Huber threshold are down-weighted, as Ceres' HuberLoss would.
+void solve(const Intrinsics& K, const std::vector<PoseObservation>& obs, const std::vector<bool>& outlier,
+           bool robust, Eigen::Isometry3d& T) {
+  const double delta = std::sqrt(kChi2);
+  double last_cost = std::numeric_limits<double>::infinity();
+  Eigen::Isometry3d last_T = T;
+  for (int it = 0; it < kIterations; ++it) {
+    Eigen::Matrix<double, 6, 6> H = Eigen::Matrix<double, 6, 6>::Zero();
+    Eigen::Matrix<double, 6, 1> b = Eigen::Matrix<double, 6, 1>::Zero();
+    double cost = 0;
+    for (size_t i = 0; i < obs.size(); ++i) {
+      if (outlier[i]) continue;
+      const Eigen::Vector3d pc = T * obs[i].point;
+      if (pc.z() <= 1e-6) continue;
+      const double iz = 1.0 / pc.z();
+      const Eigen::Vector2d r = (K.project(pc) - obs[i].uv) * obs[i].inv_sigma;
+      const double e = r.norm();
+      const double w = robust && e > delta ? delta / e : 1.0;
+      cost += robust && e > delta ? 2 * delta * e - delta * delta : e * e;
+      Eigen::Matrix<double, 2, 3> Jp;
+      Jp << K.fx * iz, 0, -K.fx * pc.x() * iz * iz, 0, K.fy * iz, -K.fy * pc.y() * iz * iz;
+      Jp *= obs[i].inv_sigma;
+      // Left perturbation T <- exp(d) T: d(pc)/d(w, rho) = [-[pc]x, I].
+      Eigen::Matrix<double, 2, 6> J;
+      J.leftCols<3>() = -Jp * skew(pc);
+      J.rightCols<3>() = Jp;
+      H.noalias() += w * J.transpose() * J;
+      b.noalias() += w * J.transpose() * r;
+    }
+    // A step that raised the cost is undone, and the solve ends there.
+    if (cost > last_cost) {
+      T = last_T;
+      return;
+    }
+    const Eigen::Matrix<double, 6, 1> d = H.ldlt().solve(-b);
+    if (!d.allFinite()) return;
+    last_cost = cost;
+    last_T = T;
+    T = expSE3(d) * T;
+    if (d.squaredNorm() < 1e-12) break;
+  }
+}
+
+}  // namespace
 
 int optimizePose(const Intrinsics& K, const std::vector<PoseObservation>& obs, Eigen::Isometry3d& T_cw,
                  std::vector<bool>& outlier) {
   outlier.assign(obs.size(), false);
   if (obs.size() < 3) return 0;
-  Eigen::Quaterniond q(T_cw.linear());
-  Eigen::Vector3d t = T_cw.translation();
-  constexpr double kChi2 = 5.991;
   int inliers = 0;
-  for (int round = 0; round < 4; ++round) {
-    ceres::Problem problem;
-    int used = 0;
-    for (size_t i = 0; i < obs.size(); ++i) {
-      if (outlier[i]) continue;
-      auto* cost = new ceres::AutoDiffCostFunction<PoseOnlyError, 2, 4, 3>(
-          new PoseOnlyError(K, obs[i].uv, obs[i].inv_sigma, obs[i].point));
-      // The last round runs without the robust kernel, on inliers only.
-      problem.AddResidualBlock(cost, round < 3 ? new ceres::HuberLoss(std::sqrt(kChi2)) : nullptr, q.coeffs().data(),
-                               t.data());
-      ++used;
-    }
-    if (used < 3) break;
-    problem.SetManifold(q.coeffs().data(), new ceres::EigenQuaternionManifold);
-    ceres::Solver::Options options;
-    options.linear_solver_type = ceres::DENSE_QR;
-    options.max_num_iterations = 10;
-    options.logging_type = ceres::SILENT;
-    ceres::Solver::Summary summary;
-    ceres::Solve(options, &problem, &summary);
+  for (int round = 0; round < kRounds; ++round) {
+    // The last round runs without the robust kernel, on inliers only.
+    const Eigen::Isometry3d before = T_cw;
+    solve(K, obs, outlier, round < kRounds - 1, T_cw);
     inliers = 0;
     for (size_t i = 0; i < obs.size(); ++i) {
-      const Eigen::Vector3d pc = q * obs[i].point + t;
-      const double chi2 = pc.z() <= 0 ? 1e9 : ((K.project(pc) - obs[i].uv) * obs[i].inv_sigma).squaredNorm();
       // Every round re-classifies all observations: an early outlier may come back.
-      outlier[i] = chi2 > kChi2;
+      outlier[i] = chi2Of(K, obs[i], T_cw) > kChi2;
       if (!outlier[i]) ++inliers;
     }
-    if (inliers < 10) break;
+    if (inliers < 10) {
+      if (round == kRounds - 1) T_cw = before;
+      break;
+    }
   }
-  T_cw.linear() = q.normalized().toRotationMatrix();
-  T_cw.translation() = t;
+  T_cw.linear() = Eigen::Quaterniond(T_cw.linear()).normalized().toRotationMatrix();
   return inliers;
 }
 
