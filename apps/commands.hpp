@@ -10,5 +10,6 @@ void addEvalCommand(CLI::App& app);
 void addInfoCommand(CLI::App& app);
 void addDemoCommand(CLI::App& app);
 void addRunCommand(CLI::App& app);
+void addVocabCommand(CLI::App& app);
 
 }  // namespace hiveslam::apps

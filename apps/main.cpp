@@ -21,6 +21,7 @@ int main(int argc, char** argv) {
   hiveslam::apps::addInfoCommand(app);
   hiveslam::apps::addDemoCommand(app);
   hiveslam::apps::addRunCommand(app);
+  hiveslam::apps::addVocabCommand(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -16,6 +16,7 @@
 #include "eval/resource_monitor.hpp"
 #include "eval/trajectory_error.hpp"
 #include "eval/trajectory_plot.hpp"
+#include "io/vocabulary_file.hpp"
 #include "io/open_dataset.hpp"
 #include "io/slam_settings_io.hpp"
 #include "io/trajectory_io.hpp"
@@ -47,7 +48,8 @@ RunSummary runSlam(const RunOptions& o) {
   const auto mode = o.sequential ? core::SlamSystem::Mode::Sequential
                     : o.realtime ? core::SlamSystem::Mode::Realtime
                                  : core::SlamSystem::Mode::Offline;
-  core::SlamSystem slam(settings, source->camera().camera, mode);
+  if (o.no_loop_closing) settings.loop_closing = false;
+  core::SlamSystem slam(settings, source->camera().camera, mode, io::loadVocabulary(settings));
   Progress progress("tracking");
   const int total = static_cast<int>(source->size().value_or(0));
   int n = 0, dropped = 0;
@@ -89,10 +91,11 @@ RunSummary runSlam(const RunOptions& o) {
     tracking_ms.push_back(r.tracking_ms);
     if (!r.tracked) continue;
     ++tracked;
-    if (map && r.map == map->id) estimate.add(r.timestamp, slam.poseOf(r));
+    if (map && slam.currentMapId(r.map) == map->id) estimate.add(r.timestamp, slam.poseOf(r));
   }
+  const auto maps = slam.liveMaps();
   size_t keyframe_count = 0;
-  for (const auto& m : slam.maps()) keyframe_count += m->keyframes.size();
+  for (const auto& m : maps) keyframe_count += m->keyframes.size();
   if (map) {
     std::vector<std::shared_ptr<core::KeyFrame>> kfs;
     for (const auto& [id, kf] : map->keyframes) kfs.push_back(kf);
@@ -108,7 +111,28 @@ RunSummary runSlam(const RunOptions& o) {
   report["tracked_frames"] = tracked;
   report["failures"] = slam.failures();
   report["keyframes"] = keyframe_count;
-  report["maps"] = slam.maps().size();
+  report["maps"] = maps.size();
+  report["map_keyframes"] = nlohmann::json::array();
+  for (const auto& m : maps) report["map_keyframes"].push_back(m->keyframes.size());
+  const auto& ls = slam.loopStats();
+  report["loop_closing"] = settings.loop_closing;
+  report["loops"] = ls.loops;
+  report["merges"] = ls.merges;
+  report["global_bas"] = ls.global_bas;
+  std::vector<eval::PlotEvent> plot_events;
+  report["loop_events"] = nlohmann::json::array();
+  for (const auto& e : ls.events) {
+    const char* kind = e.kind == core::LoopEvent::Kind::Loop ? "loop" : "merge";
+    report["loop_events"].push_back({{"kind", kind}, {"timestamp", e.timestamp}, {"matches", e.matches},
+                                     {"scale", e.scale}, {"correct_ms", e.correct_ms},
+                                     {"essential_graph_ms", e.essential_graph_ms}});
+    plot_events.push_back({e.timestamp, kind});
+  }
+  report["loop_timing"] = {{"keyframes_checked", ls.keyframes_checked},
+                           {"query_ms_mean", ls.query_ms_total / std::max(ls.keyframes_checked, 1)},
+                           {"rejected_geometry", ls.rejected_geometry},
+                           {"global_bas_discarded", ls.global_bas_discarded},
+                           {"global_ba_ms", ls.global_ba_ms}};
   report["mode"] = o.sequential ? "sequential" : o.realtime ? "realtime" : "offline";
   if (o.realtime) report["dropped_frames"] = dropped;
   report["cpu_seconds"] = monitor.cpuSeconds();
@@ -123,7 +147,7 @@ RunSummary runSlam(const RunOptions& o) {
   const auto& ms = slam.mappingStats();
   report["mapping"] = {{"keyframes_processed", ms.keyframes_processed}, {"points_created", ms.points_created},
                        {"points_culled", ms.points_culled}, {"keyframes_culled", ms.keyframes_culled},
-                       {"local_bas", ms.local_bas}};
+                       {"local_bas", ms.local_bas}, {"local_bas_discarded", ms.local_bas_discarded}};
   std::string ate_line = "no ground truth";
   if (source->groundTruth() && estimate.size() >= 3) {
     try {
@@ -134,7 +158,7 @@ RunSummary runSlam(const RunOptions& o) {
       eval::plotTopView(out / "trajectory.png", ate.pair.ref, ate.pair.est,
                         {fmt::format("ATE RMSE {:.4f} m over {:.1f} m ({} poses)", ate.stats.rmse, ate.reference_length,
                                      ate.stats.count),
-                         900, {}});
+                         900, plot_events});
       ate_line = fmt::format("ATE RMSE {:.4f} m ({:.2f}% of {:.1f} m)", ate.stats.rmse,
                              100.0 * ate.stats.rmse / std::max(ate.reference_length, 1e-9), ate.reference_length);
     } catch (const InputError& e) {
@@ -146,7 +170,8 @@ RunSummary runSlam(const RunOptions& o) {
   summary.report = report;
   summary.line = fmt::format("frames {} tracked {} ({:.1f}%) failures {} keyframes {} maps {} | {} | tracking median {:.1f} ms",
                              n, tracked, 100.0 * tracked / std::max(n, 1), slam.failures(), keyframe_count,
-                             slam.maps().size(), ate_line, percentile(tracking_ms, 0.5));
+                             maps.size(), ate_line, percentile(tracking_ms, 0.5));
+  if (settings.loop_closing) summary.line += fmt::format(" | loops {} merges {}", ls.loops, ls.merges);
   return summary;
 }
 
@@ -160,6 +185,7 @@ void addRunCommand(CLI::App& app) {
   cmd->add_flag("--sequential", o->sequential, "Lockstep tracking and mapping on one thread (deterministic)");
   cmd->add_flag("--realtime", o->realtime, "Feed frames at their timestamps; tracking never waits for mapping");
   cmd->add_option("--max-frames", o->max_frames, "Stop after this many frames");
+  cmd->add_flag("--no-loop-closing", o->no_loop_closing, "Switch loop closing and map merging off");
   cmd->add_flag("--verbose", o->verbose, "One line per frame instead of the progress line");
   cmd->callback([o]() { fmt::print("{}\n", runSlam(*o).line); });
 }

@@ -11,6 +11,7 @@ struct RunOptions {
   bool sequential = false;
   bool verbose = false;
   bool realtime = false;
+  bool no_loop_closing = false;
   int max_frames = 0;
 };
 

@@ -45,6 +45,17 @@ void applySlamSettings(const std::filesystem::path& file, core::SlamSettings& s)
       {"fusion_neighbours", set(s.fusion_neighbours)},
       {"local_ba_iterations", set(s.local_ba_iterations)},
       {"redundant_keyframe_ratio", set(s.redundant_keyframe_ratio)},
+      {"loop_closing", set(s.loop_closing)},
+      {"loop_min_keyframes", set(s.loop_min_keyframes)},
+      {"loop_consistency", set(s.loop_consistency)},
+      {"loop_min_bow_matches", set(s.loop_min_bow_matches)},
+      {"loop_min_sim3_inliers", set(s.loop_min_sim3_inliers)},
+      {"loop_min_total_matches", set(s.loop_min_total_matches)},
+      {"loop_min_inlier_ratio", set(s.loop_min_inlier_ratio)},
+      {"essential_graph_min_weight", set(s.essential_graph_min_weight)},
+      {"essential_graph_iterations", set(s.essential_graph_iterations)},
+      {"global_ba_iterations", set(s.global_ba_iterations)},
+      {"vocabulary", set(s.vocabulary)},
       {"seed", set(s.seed)},
   };
   const std::map<std::string, std::function<void(const YAML::Node&)>> orb_keys{

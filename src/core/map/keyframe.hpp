@@ -10,6 +10,7 @@
 
 #include "core/frame/frame.hpp"
 #include "core/map/ids.hpp"
+#include "core/place/bow_vector.hpp"
 
 namespace hiveslam::core {
 
@@ -28,6 +29,19 @@ class KeyFrame : public std::enable_shared_from_this<KeyFrame> {
   KeyFrame* parent = nullptr;
   std::set<KeyFrame*, ById> children;
   bool bad = false;
+  // Bag of words of the image, set before the keyframe is shared and never changed after.
+  place::BowVector bow;
+  place::FeatureVector bow_features;
+  // Loop and merge links: kept by the essential graph, and never culled.
+  std::set<KeyFrame*, ById> loop_edges;
+
+  // A culled keyframe keeps its pose relative to its parent (set when it leaves the map): frames
+  // tracked against it follow every later correction of the map through pose().
+  Eigen::Isometry3d T_c_parent = Eigen::Isometry3d::Identity();
+  // The current pose: T_cw, or for a culled keyframe its pose through the spanning tree.
+  Eigen::Isometry3d pose() const {
+    return bad && parent ? T_c_parent * parent->pose() : T_cw;
+  }
 
   Eigen::Vector3d center() const { return T_cw.inverse().translation(); }
   // Keyframes sharing the most points, best first.

@@ -38,6 +38,7 @@ void Map::replace(MapPoint& old, const std::shared_ptr<MapPoint>& by) {
 
 void Map::erase(KeyFrame& kf) {
   if (&kf == origin) return;  // the origin anchors the map's coordinate frame
+  if (kf.parent) kf.T_c_parent = kf.T_cw * kf.parent->pose().inverse();
   kf.bad = true;
   for (auto& p : kf.points)
     if (p) {
@@ -45,6 +46,8 @@ void Map::erase(KeyFrame& kf) {
       p.reset();
     }
   for (auto& [other, w] : kf.covisibility) other->covisibility.erase(&kf);
+  for (KeyFrame* other : kf.loop_edges) other->loop_edges.erase(&kf);
+  kf.loop_edges.clear();
   // Children are re-parented to this keyframe's parent (keeps the spanning tree connected).
   for (KeyFrame* child : kf.children) {
     child->parent = kf.parent;

@@ -5,6 +5,7 @@
 // and map points, and of their fields, happens while holding that map's `mutex`. Modules take it
 // for one step at a time (a tracking query, a local BA write-back) and never hold two maps'
 // mutexes at once.
+#include <atomic>
 #include <memory>
 #include <mutex>
 #include <unordered_map>
@@ -23,6 +24,18 @@ class Map {
   std::unordered_map<Id, std::shared_ptr<KeyFrame>> keyframes;
   std::unordered_map<Id, std::shared_ptr<MapPoint>> points;
   KeyFrame* origin = nullptr;  // the first keyframe, fixed in optimizations
+  // Bumped by every change of the map's coordinate frame (loop correction, merge, global BA):
+  // work computed on copies under an older epoch (a local BA) is discarded, and tracking
+  // re-poses its last frame through its reference keyframe.
+  uint64_t epoch = 0;
+  // Set when this map was merged into another; its keyframes and points live on there.
+  std::atomic<Map*> merged_into{nullptr};
+  // The map that a merged map's contents live in now (itself when not merged).
+  Map* resolve() {
+    Map* m = this;
+    while (Map* next = m->merged_into.load()) m = next;
+    return m;
+  }
   // Culled keyframes stay alive (frames keep poses relative to them) but leave the map.
   std::vector<std::shared_ptr<KeyFrame>> retired;
   // Erased points stay alive until the next collectGarbage(): a module may still hold a plain

@@ -6,6 +6,7 @@
 #include "core/features/hamming.hpp"
 #include "core/features/rotation_histogram.hpp"
 #include "core/geometry/triangulation.hpp"
+#include "core/matching/fusion.hpp"
 #include "core/matching/projection_matcher.hpp"
 #include "core/optim/bundle_adjustment.hpp"
 
@@ -30,6 +31,7 @@ struct LocalMapper::LocalBa {
   std::vector<MapPoint*> points;
   std::vector<std::pair<KeyFrame*, MapPoint*>> observations;
   BaSummary summary;
+  uint64_t epoch = 0;  // the map's epoch when the copies were taken
 };
 
 void LocalMapper::process(const std::shared_ptr<Map>& map, const std::shared_ptr<KeyFrame>& kf,
@@ -167,42 +169,6 @@ void LocalMapper::triangulateNewPoints(Map& map, KeyFrame& kf) {
   }
 }
 
-namespace {
-
-// Projects `points` into `kf` and merges each with the keypoint found there: observation added,
-// or the two points fused (the one with more observations survives).
-// `points` is a copy: fusing rewrites keyframe slots, possibly the very vector it came from.
-void fuseInto(Map& map, KeyFrame& kf, std::vector<std::shared_ptr<MapPoint>> points,
-              const std::vector<double>& scales) {
-  const Eigen::Vector3d C = kf.center();
-  for (const auto& p : points) {
-    if (!p || p->bad || p->observations.count(&kf)) continue;
-    const Eigen::Vector3d pc = kf.T_cw * p->position;
-    if (pc.z() <= 0) continue;
-    const Eigen::Vector2d uv = kf.frame.K.project(pc);
-    if (!kf.frame.inImage(uv)) continue;
-    const Eigen::Vector3d ray = p->position - C;
-    const double dist = ray.norm();
-    if (dist < 0.8 * p->min_distance || dist > 1.2 * p->max_distance || ray.dot(p->normal) < 0.5 * dist) continue;
-    const int level = p->predictLevel(dist, scales);
-    const double s = scales[static_cast<size_t>(level)];
-    const int j = bestNear(kf.frame, uv, 3.0 * s, level - 1, level + 1, p->descriptor.ptr<uchar>(), kMatchLow);
-    if (j < 0) continue;
-    const double s_kp = scales[static_cast<size_t>(kf.frame.keypoints[static_cast<size_t>(j)].octave)];
-    if ((kf.frame.points[static_cast<size_t>(j)] - uv).squaredNorm() > 5.991 * s_kp * s_kp) continue;
-    auto existing = kf.points[static_cast<size_t>(j)];
-    if (existing && !existing->bad) {
-      if (existing == p) continue;
-      if (existing->observations.size() > p->observations.size()) map.replace(*p, existing);
-      else map.replace(*existing, p);
-    } else {
-      Map::observe(kf, j, p);
-    }
-  }
-}
-
-}  // namespace
-
 void LocalMapper::fuse(Map& map, KeyFrame& kf) {
   std::vector<KeyFrame*> targets;
   std::set<KeyFrame*> in;
@@ -211,13 +177,13 @@ void LocalMapper::fuse(Map& map, KeyFrame& kf) {
     for (KeyFrame* n2 : n->bestCovisible(5))
       if (n2 != &kf && in.insert(n2).second) targets.push_back(n2);
   }
-  for (KeyFrame* t : targets) fuseInto(map, *t, kf.points, scales_);
+  for (KeyFrame* t : targets) fusePoints(map, *t, kf.points, scales_);
   std::vector<std::shared_ptr<MapPoint>> theirs;
   std::set<MapPoint*> seen;
   for (KeyFrame* t : targets)
     for (const auto& p : t->points)
       if (p && !p->bad && seen.insert(p.get()).second) theirs.push_back(p);
-  fuseInto(map, kf, theirs, scales_);
+  fusePoints(map, kf, theirs, scales_);
   for (const auto& p : kf.points)
     if (p && !p->bad) p->update(scales_);
   kf.updateConnections();
@@ -225,6 +191,7 @@ void LocalMapper::fuse(Map& map, KeyFrame& kf) {
 
 LocalMapper::LocalBa LocalMapper::prepareLocalBa(Map& map, KeyFrame& kf) {
   LocalBa out;
+  out.epoch = map.epoch;
   std::vector<KeyFrame*> local{&kf};
   for (const auto& [n, w] : kf.covisibility)
     if (!n->bad) local.push_back(n);
@@ -277,6 +244,12 @@ LocalMapper::LocalBa LocalMapper::prepareLocalBa(Map& map, KeyFrame& kf) {
 }
 
 void LocalMapper::applyLocalBa(Map& map, LocalBa& ba) {
+  // A loop correction, merge or global BA moved the map while this BA ran on copies: its
+  // result is in the old frame and is dropped.
+  if (map.epoch != ba.epoch || map.merged_into.load()) {
+    ++stats_.local_bas_discarded;
+    return;
+  }
   ++stats_.local_bas;
   for (size_t k = 0; k < ba.keyframes.size(); ++k) {
     const auto& pose = ba.problem.poses[k];
@@ -300,7 +273,8 @@ void LocalMapper::applyLocalBa(Map& map, LocalBa& ba) {
 
 void LocalMapper::cullKeyframes(Map& map, KeyFrame& kf) {
   for (KeyFrame* k : kf.bestCovisible(1000)) {
-    if (k == map.origin || k == &kf || k->bad) continue;
+    // Loop and merge links hold the essential graph together: their keyframes stay.
+    if (k == map.origin || k == &kf || k->bad || !k->loop_edges.empty()) continue;
     int total = 0, redundant = 0;
     for (size_t i = 0; i < k->points.size(); ++i) {
       const auto& p = k->points[i];
@@ -315,6 +289,7 @@ void LocalMapper::cullKeyframes(Map& map, KeyFrame& kf) {
     }
     if (total > 0 && redundant > settings_.redundant_keyframe_ratio * total) {
       map.erase(*k);
+      if (database_) database_->erase(k);
       ++stats_.keyframes_culled;
     }
   }

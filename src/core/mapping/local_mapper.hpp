@@ -7,12 +7,14 @@
 #include <memory>
 
 #include "core/map/map.hpp"
+#include "core/place/keyframe_database.hpp"
 #include "core/system/slam_settings.hpp"
 
 namespace hiveslam::core {
 
 struct MappingStats {
-  int keyframes_processed = 0, points_created = 0, points_culled = 0, keyframes_culled = 0, local_bas = 0;
+  int keyframes_processed = 0, points_created = 0, points_culled = 0, keyframes_culled = 0, local_bas = 0,
+      local_bas_discarded = 0;
 };
 
 class LocalMapper {
@@ -24,6 +26,8 @@ class LocalMapper {
   void process(const std::shared_ptr<Map>& map, const std::shared_ptr<KeyFrame>& kf,
                const std::atomic<bool>* abort_ba = nullptr);
   const MappingStats& stats() const { return stats_; }
+  // Culled keyframes leave the place recognition database too.
+  void setDatabase(KeyframeDatabase* database) { database_ = database; }
 
  private:
   void insert(Map& map, KeyFrame& kf);
@@ -46,6 +50,7 @@ class LocalMapper {
   };
   std::list<Recent> recent_;
   MappingStats stats_;
+  KeyframeDatabase* database_ = nullptr;
 };
 
 }  // namespace hiveslam::core

@@ -2,6 +2,7 @@
 // Every threshold of the SLAM core in one plain struct with its defaults; the settings file's
 // `slam:` section overrides any of them (io/slam_settings_io reads it).
 #include <cstdint>
+#include <string>
 
 #include "core/features/orb_extractor.hpp"
 
@@ -32,6 +33,18 @@ struct SlamSettings {
   int fusion_neighbours = 10;
   int local_ba_iterations = 10;
   double redundant_keyframe_ratio = 0.9;
+  // Loop closing and map merging
+  bool loop_closing = true;
+  std::string vocabulary;              // file; empty: the one shipped in data/vocabulary
+  int loop_min_keyframes = 12;         // a map this small is not searched for loops
+  int loop_consistency = 3;            // consecutive keyframes that must agree on a place
+  int loop_min_bow_matches = 20;       // keyframe pair matches before Sim3 RANSAC
+  int loop_min_sim3_inliers = 20;
+  double loop_min_inlier_ratio = 0.5;  // of the matches after guided matching
+  int loop_min_total_matches = 40;     // Sim3 inliers + matches of the place's points
+  int essential_graph_min_weight = 100;  // covisibility edges kept in the essential graph
+  int essential_graph_iterations = 20;
+  int global_ba_iterations = 10;
   // Determinism: RANSAC seed
   uint64_t seed = 1;
 };

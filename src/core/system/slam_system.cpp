@@ -4,16 +4,35 @@
 
 namespace hiveslam::core {
 
+namespace {
+
+SlamSettings withLoopClosing(SlamSettings s, const place::Vocabulary* vocabulary) {
+  if (!vocabulary || vocabulary->empty()) s.loop_closing = false;
+  return s;
+}
+
+}  // namespace
+
 SlamSystem::SlamSystem(const SlamSettings& settings, std::shared_ptr<const camera::CameraModel> camera, Mode mode,
-                       uint16_t node)
-    : settings_(settings),
+                       std::shared_ptr<const place::Vocabulary> vocabulary, uint16_t node)
+    : settings_(withLoopClosing(settings, vocabulary.get())),
       camera_(std::move(camera)),
       ids_(node),
       extractor_(settings.orb),
-      tracker_(settings, ids_, extractor_.scales()),
-      mapper_(settings, ids_, extractor_.scales()),
+      vocabulary_(std::move(vocabulary)),
+      tracker_(settings_, ids_, extractor_.scales()),
+      mapper_(settings_, ids_, extractor_.scales()),
+      closer_(settings_, database_, extractor_.scales()),
       mode_(mode) {
-  if (mode_ != Mode::Sequential) mapping_thread_ = std::thread([this] { mappingLoop(); });
+  if (vocabulary_ && !vocabulary_->empty()) {
+    tracker_.setPlaceRecognition(vocabulary_.get(), &database_);
+    mapper_.setDatabase(&database_);
+  }
+  closer_.setActiveMap(&active_map_);
+  if (mode_ != Mode::Sequential) {
+    mapping_thread_ = std::thread([this] { mappingLoop(); });
+    if (settings_.loop_closing) loop_thread_ = std::thread([this] { loopLoop(); });
+  }
   if (mode_ == Mode::Offline) tracker_.setWaitForMapping([this] { waitForMapping(); });
 }
 
@@ -27,13 +46,26 @@ SlamSystem::~SlamSystem() { finish(); }
 void SlamSystem::finish() {
   jobs_.close();
   if (mapping_thread_.joinable()) mapping_thread_.join();
+  loop_jobs_.close();
+  if (loop_thread_.joinable()) loop_thread_.join();
+}
+
+void SlamSystem::loopLoop() {
+  while (auto job = loop_jobs_.pop()) closer_.process(job->map, job->keyframe);
 }
 
 void SlamSystem::mappingLoop() {
   while (auto job = jobs_.pop()) {
     mapping_busy_ = true;
     abort_ba_ = jobs_.size() > 0;  // already a newer keyframe waiting: keep the BA short
-    mapper_.process(job->map, job->keyframe, &abort_ba_);
+    // A keyframe posed in a map that has since been merged into another is in the old frame:
+    // it is dropped (tracking has moved on to the merged map by then).
+    if (job->map->merged_into.load()) {
+      ++stale_keyframes_;
+    } else {
+      mapper_.process(job->map, job->keyframe, &abort_ba_);
+      if (settings_.loop_closing) loop_jobs_.push(*job);
+    }
     mapping_busy_ = false;
     {
       std::lock_guard lock(idle_mutex_);
@@ -51,7 +83,10 @@ const FrameRecord& SlamSystem::process(const cv::Mat& gray, double timestamp) {
   const bool idle = mode_ == Mode::Sequential || (!mapping_busy_ && jobs_.size() == 0);
   TrackingOutput out = tracker_.track(makeFrame(gray, r.index, timestamp, extractor_, *camera_), idle);
   r.tracking_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-  if (out.new_map) maps_.push_back(out.new_map);
+  if (out.new_map) {
+    maps_.push_back(out.new_map);
+    active_map_ = out.new_map.get();
+  }
   r.inliers = out.inliers;
   r.keyframe = out.new_keyframe != nullptr;
   if (out.tracked && out.reference) {
@@ -63,6 +98,7 @@ const FrameRecord& SlamSystem::process(const cv::Mat& gray, double timestamp) {
   if (out.new_keyframe) {
     if (mode_ == Mode::Sequential) {
       mapper_.process(tracker_.map(), out.new_keyframe);
+      closer_.process(tracker_.map(), out.new_keyframe);
     } else {
       abort_ba_ = true;  // a newer keyframe: the running local BA stops early
       {
@@ -77,7 +113,20 @@ const FrameRecord& SlamSystem::process(const cv::Mat& gray, double timestamp) {
 }
 
 Eigen::Isometry3d SlamSystem::poseOf(const FrameRecord& r) const {
-  return (r.T_c_ref * r.reference->T_cw).inverse();
+  return (r.T_c_ref * r.reference->pose()).inverse();
+}
+
+Id SlamSystem::currentMapId(Id map) const {
+  for (const auto& m : maps_)
+    if (m->id == map) return m->resolve()->id;
+  return map;
+}
+
+std::vector<std::shared_ptr<Map>> SlamSystem::liveMaps() const {
+  std::vector<std::shared_ptr<Map>> out;
+  for (const auto& m : maps_)
+    if (!m->merged_into.load()) out.push_back(m);
+  return out;
 }
 
 std::shared_ptr<Map> SlamSystem::largestMap() const {

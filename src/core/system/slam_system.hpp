@@ -1,8 +1,9 @@
 #pragma once
-// The SLAM system of one node: tracking and local mapping behind one call per frame.
-// Threaded (default): tracking runs on the caller's thread and hands keyframes to the local
-// mapping thread through a queue. Sequential: each frame is tracked, then its keyframe, if any,
-// is mapped before the next frame, so the same input always gives the same trajectory.
+// The SLAM system of one node: tracking, local mapping and loop closing behind one call per
+// frame. Threaded (default): tracking runs on the caller's thread and hands keyframes to the
+// local mapping thread through a queue, which hands them on to the loop closing thread.
+// Sequential: each frame is tracked, then its keyframe, if any, is mapped and checked for loops
+// before the next frame, so the same input always gives the same trajectory.
 #include <atomic>
 #include <condition_variable>
 #include <mutex>
@@ -13,6 +14,7 @@
 #include "common/blocking_queue.hpp"
 
 #include "core/camera/camera_model.hpp"
+#include "core/loop/loop_closer.hpp"
 #include "core/mapping/local_mapper.hpp"
 #include "core/tracking/tracker.hpp"
 
@@ -37,8 +39,9 @@ class SlamSystem {
     Offline,     // threaded; tracking waits for mapping when a keyframe is due (full accuracy)
     Realtime,    // threaded; tracking never waits (keyframes are skipped while mapping is busy)
   };
+  // Without a vocabulary there is no loop closing, and relocalization searches recent keyframes.
   SlamSystem(const SlamSettings& settings, std::shared_ptr<const camera::CameraModel> camera, Mode mode,
-             uint16_t node = 0);
+             std::shared_ptr<const place::Vocabulary> vocabulary = nullptr, uint16_t node = 0);
   ~SlamSystem();
   SlamSystem(const SlamSystem&) = delete;
   SlamSystem& operator=(const SlamSystem&) = delete;
@@ -54,6 +57,11 @@ class SlamSystem {
   const std::vector<std::shared_ptr<Map>>& maps() const { return maps_; }
   int failures() const { return tracker_.failures(); }
   const MappingStats& mappingStats() const { return mapper_.stats(); }
+  const LoopStats& loopStats() const { return closer_.stats(); }
+  // The map a frame's poses live in now (a merged map's frames live in the map it joined).
+  Id currentMapId(Id map) const;
+  // Maps that still hold keyframes (not merged into another).
+  std::vector<std::shared_ptr<Map>> liveMaps() const;
   // Current camera-to-world pose of a tracked frame (through its reference keyframe, so later
   // optimizations of the keyframes move it too).
   Eigen::Isometry3d poseOf(const FrameRecord& r) const;
@@ -65,8 +73,11 @@ class SlamSystem {
   std::shared_ptr<const camera::CameraModel> camera_;
   IdGenerator ids_;
   features::OrbExtractor extractor_;
+  std::shared_ptr<const place::Vocabulary> vocabulary_;
+  KeyframeDatabase database_;
   Tracker tracker_;
   LocalMapper mapper_;
+  LoopCloser closer_;
   std::vector<std::shared_ptr<Map>> maps_;
   std::vector<FrameRecord> records_;
 
@@ -75,6 +86,7 @@ class SlamSystem {
     std::shared_ptr<KeyFrame> keyframe;
   };
   void mappingLoop();
+  void loopLoop();
   void waitForMapping();
   Mode mode_;
   BlockingQueue<MappingJob> jobs_;
@@ -84,6 +96,10 @@ class SlamSystem {
   size_t jobs_pushed_ = 0, jobs_done_ = 0;  // guarded by idle_mutex_
   std::atomic<bool> abort_ba_{false};
   std::thread mapping_thread_;
+  BlockingQueue<MappingJob> loop_jobs_;
+  std::thread loop_thread_;
+  std::atomic<int> stale_keyframes_{0};
+  std::atomic<Map*> active_map_{nullptr};  // tracking's map, for the loop closer  // queued for a map that was merged meanwhile
 };
 
 }  // namespace hiveslam::core

@@ -6,6 +6,7 @@
 
 #include "core/features/hamming.hpp"
 #include "core/geometry/two_view.hpp"
+#include "core/matching/bow_matcher.hpp"
 #include "core/matching/initial_matcher.hpp"
 #include "core/optim/bundle_adjustment.hpp"
 #include "core/optim/pose_optimizer.hpp"
@@ -32,6 +33,12 @@ TrackingOutput Tracker::track(Frame frame, bool mapping_idle) {
   }
 
   std::unique_lock lock(map_->mutex);
+  // Loop closing, a merge or a global BA moved the map: the last frame's pose is re-derived
+  // from its reference keyframe, as the motion model predicts from it.
+  if (map_->epoch != epoch_seen_) {
+    if (last_ && last_reference_) last_->T_cw = last_T_c_ref_ * last_reference_->pose();
+    epoch_seen_ = map_->epoch;
+  }
   bool ok = false;
   if (state_ == TrackingState::Ok) {
     ok = (have_velocity_ && trackWithMotionModel(current)) || trackReferenceKeyframe(current);
@@ -91,7 +98,10 @@ TrackingOutput Tracker::track(Frame frame, bool mapping_idle) {
     last_keyframe_frame_ = current.frame.index;
   }
   out.reference = reference_;
-  out.T_c_ref = current.T_cw * reference_->T_cw.inverse();
+  out.T_c_ref = current.T_cw * reference_->pose().inverse();
+  last_reference_ = reference_;
+  last_T_c_ref_ = out.T_c_ref;
+  epoch_seen_ = map_->epoch;
   out.state = state_;
   // Outliers do not go forward to the next frame's matching.
   for (size_t i = 0; i < current.points.size(); ++i)
@@ -137,6 +147,8 @@ bool Tracker::initialize(Tracked& current, TrackingOutput& out) {
   auto map = std::make_shared<Map>(ids_.next());
   auto kf1 = std::make_shared<KeyFrame>(ids_.next(), f1, Eigen::Isometry3d::Identity());
   auto kf2 = std::make_shared<KeyFrame>(ids_.next(), f2, r.T_21);
+  describePlace(*kf1);
+  describePlace(*kf2);
   map->add(kf1);
   map->add(kf2);
   map->origin = kf1.get();
@@ -193,6 +205,9 @@ bool Tracker::initialize(Tracked& current, TrackingOutput& out) {
     p->update(scales_);
   }
   map_ = map;
+  epoch_seen_ = map->epoch;
+  last_reference_ = kf2;
+  last_T_c_ref_ = Eigen::Isometry3d::Identity();
   keyframes_made_ = 2;
   reference_ = kf2;
   current.T_cw = kf2->T_cw;
@@ -300,37 +315,67 @@ bool Tracker::trackLocalMap(Tracked& c, int min_inliers) {
   return inliers_ >= min_inliers;
 }
 
-bool Tracker::relocalize(Tracked& c) {
-  // Candidates: the most recent keyframes (bag-of-words candidates come with the next layer).
+std::vector<std::shared_ptr<KeyFrame>> Tracker::relocalizationCandidates(const Frame& frame,
+                                                                        place::FeatureVector& features) const {
   std::vector<std::shared_ptr<KeyFrame>> kfs;
-  for (const auto& [id, kf] : map_->keyframes) kfs.push_back(kf);
-  std::sort(kfs.begin(), kfs.end(), [](const auto& a, const auto& b) { return a->id > b->id; });
-  const size_t stride = std::max<size_t>(1, kfs.size() / 20);
-  for (size_t k = 0; k < kfs.size(); k += stride) {
+  if (vocabulary_ && database_) {
+    // Keyframes of this map that look like the frame, best first.
+    place::BowVector bow;
+    vocabulary_->transform(frame.descriptors, bow, features);
+    for (const auto& c : database_->query(bow, {})) {
+      if (c.map != map_.get() || c.keyframe->bad) continue;
+      auto it = map_->keyframes.find(c.keyframe->id);
+      if (it != map_->keyframes.end()) kfs.push_back(it->second);
+      if (kfs.size() >= 10) break;
+    }
+    return kfs;
+  }
+  // Without a vocabulary: a spread of the keyframes, most recent first.
+  std::vector<std::shared_ptr<KeyFrame>> all;
+  for (const auto& [id, kf] : map_->keyframes) all.push_back(kf);
+  std::sort(all.begin(), all.end(), [](const auto& a, const auto& b) { return a->id > b->id; });
+  const size_t stride = std::max<size_t>(1, all.size() / 20);
+  for (size_t k = 0; k < all.size(); k += stride) kfs.push_back(all[k]);
+  return kfs;
+}
+
+bool Tracker::relocalize(Tracked& c) {
+  place::FeatureVector features;
+  const auto kfs = relocalizationCandidates(c.frame, features);
+  for (size_t k = 0; k < kfs.size(); ++k) {
     const KeyFrame& kf = *kfs[k];
     std::vector<cv::Point3d> object;
     std::vector<cv::Point2d> image;
     std::vector<int> index;
     PointSlots slots(c.frame.size());
-    for (size_t j = 0; j < kf.points.size(); ++j) {
-      const auto& p = kf.points[j];
-      if (!p || p->bad) continue;
-      int best = 256, second = 256, best_i = -1;
-      for (int i = 0; i < static_cast<int>(c.frame.size()); ++i) {
-        const int d = features::hamming(p->descriptor.ptr<uchar>(), c.frame.descriptors.ptr<uchar>(i));
-        if (d < best) {
-          second = best;
-          best = d;
-          best_i = i;
-        } else if (d < second) {
-          second = d;
-        }
-      }
-      if (best_i < 0 || best > kMatchLow || best > 0.75 * second || slots[static_cast<size_t>(best_i)]) continue;
-      slots[static_cast<size_t>(best_i)] = p;
+    auto add = [&](int i, const std::shared_ptr<MapPoint>& p) {
+      slots[static_cast<size_t>(i)] = p;
       object.emplace_back(p->position.x(), p->position.y(), p->position.z());
-      image.emplace_back(c.frame.points[static_cast<size_t>(best_i)].x(), c.frame.points[static_cast<size_t>(best_i)].y());
-      index.push_back(best_i);
+      image.emplace_back(c.frame.points[static_cast<size_t>(i)].x(), c.frame.points[static_cast<size_t>(i)].y());
+      index.push_back(i);
+    };
+    if (!features.empty() && !kf.bow_features.empty()) {
+      const std::vector<int> m = matchFrameByBow(c.frame, features, kf);
+      for (size_t i = 0; i < m.size(); ++i)
+        if (m[i] >= 0) add(static_cast<int>(i), kf.points[static_cast<size_t>(m[i])]);
+    } else {
+      for (size_t j = 0; j < kf.points.size(); ++j) {
+        const auto& p = kf.points[j];
+        if (!p || p->bad) continue;
+        int best = 256, second = 256, best_i = -1;
+        for (int i = 0; i < static_cast<int>(c.frame.size()); ++i) {
+          const int d = features::hamming(p->descriptor.ptr<uchar>(), c.frame.descriptors.ptr<uchar>(i));
+          if (d < best) {
+            second = best;
+            best = d;
+            best_i = i;
+          } else if (d < second) {
+            second = d;
+          }
+        }
+        if (best_i < 0 || best > kMatchLow || best > 0.75 * second || slots[static_cast<size_t>(best_i)]) continue;
+        add(best_i, p);
+      }
     }
     if (object.size() < 15) continue;
     cv::Mat rvec, tvec, inliers;
@@ -371,8 +416,13 @@ bool Tracker::needKeyframe(const Tracked& c, bool mapping_idle) const {
   return timely && keyframeWanted(c);
 }
 
+void Tracker::describePlace(KeyFrame& kf) const {
+  if (vocabulary_) vocabulary_->transform(kf.frame.descriptors, kf.bow, kf.bow_features);
+}
+
 std::shared_ptr<KeyFrame> Tracker::makeKeyframe(const Tracked& c) {
   auto kf = std::make_shared<KeyFrame>(ids_.next(), c.frame, c.T_cw);
+  describePlace(*kf);
   for (size_t i = 0; i < c.points.size(); ++i)
     if (c.points[i] && !c.outlier[i] && !c.points[i]->bad) kf->points[i] = c.points[i];
   return kf;

@@ -8,6 +8,8 @@
 
 #include "core/map/map.hpp"
 #include "core/matching/projection_matcher.hpp"
+#include "core/place/keyframe_database.hpp"
+#include "core/place/vocabulary.hpp"
 #include "core/system/slam_settings.hpp"
 
 namespace hiveslam::core {
@@ -35,6 +37,11 @@ class Tracker {
   // mapping is busy, tracking waits for it instead of skipping the keyframe, so the map keeps
   // up with a camera that moves faster than real time. It is called without the map lock.
   void setWaitForMapping(std::function<void()> wait) { wait_for_mapping_ = std::move(wait); }
+  // Place recognition: keyframes get their bag of words, relocalization asks the database.
+  void setPlaceRecognition(const place::Vocabulary* vocabulary, const KeyframeDatabase* database) {
+    vocabulary_ = vocabulary;
+    database_ = database;
+  }
   TrackingState state() const { return state_; }
   int failures() const { return failures_; }
   const std::shared_ptr<Map>& map() const { return map_; }
@@ -52,6 +59,9 @@ class Tracker {
   bool trackReferenceKeyframe(Tracked& current);
   bool trackLocalMap(Tracked& current, int min_inliers);
   bool relocalize(Tracked& current);
+  std::vector<std::shared_ptr<KeyFrame>> relocalizationCandidates(const Frame& frame,
+                                                                  place::FeatureVector& features) const;
+  void describePlace(KeyFrame& kf) const;
   int optimize(Tracked& current);
   bool needKeyframe(const Tracked& current, bool mapping_idle) const;
   bool keyframeWanted(const Tracked& current) const;  // the point-ratio half of the decision
@@ -74,6 +84,12 @@ class Tracker {
   // behind a busy local mapping thread.
   int keyframes_made_ = 0;
   std::function<void()> wait_for_mapping_;
+  const place::Vocabulary* vocabulary_ = nullptr;
+  const KeyframeDatabase* database_ = nullptr;
+  // The last frame relative to its reference keyframe, and the map epoch it was posed in.
+  std::shared_ptr<KeyFrame> last_reference_;
+  Eigen::Isometry3d last_T_c_ref_ = Eigen::Isometry3d::Identity();
+  uint64_t epoch_seen_ = 0;
 };
 
 }  // namespace hiveslam::core

@@ -1,0 +1,87 @@
+#pragma once
+// The loop closing module (the paper's LC task): for every keyframe local mapping has finished,
+// place recognition against the keyframe database; a place of the same map seen by enough
+// consecutive keyframes and confirmed geometrically (Sim3 RANSAC on bag-of-words matches, then
+// refinement and guided matching) closes a loop: the keyframes around the current one are
+// corrected by the Sim3, the two sides fused, the essential graph optimized and a global BA run.
+// A place of another map merges that map into this one (Sim3 welding, fusion, global BA).
+//
+// Threads: process() runs on the loop closing thread. Optimizations run on copies without the
+// map mutex and are applied under it, bumping the map's epoch (see map.hpp). The merge is the
+// one step that holds two maps' mutexes, taken together by std::scoped_lock.
+#include <atomic>
+#include <map>
+#include <memory>
+#include <set>
+#include <unordered_map>
+#include <vector>
+
+#include "core/geometry/sim3.hpp"
+#include "core/map/map.hpp"
+#include "core/place/keyframe_database.hpp"
+#include "core/system/slam_settings.hpp"
+
+namespace hiveslam::core {
+
+struct LoopEvent {
+  enum class Kind { Loop, Merge } kind = Kind::Loop;
+  double timestamp = 0;  // of the keyframe that recognized the place
+  Id keyframe = kNoId, matched = kNoId;
+  Id map = kNoId, merged_map = kNoId;
+  int matches = 0;
+  double scale = 1.0;   // scale of the correcting Sim3 (drift seen at the loop)
+  double detect_ms = 0, correct_ms = 0, essential_graph_ms = 0;
+};
+
+struct LoopStats {
+  int keyframes_checked = 0, loops = 0, merges = 0, global_bas = 0, global_bas_discarded = 0;
+  int rejected_geometry = 0;  // consistent places that failed Sim3 verification
+  double query_ms_total = 0, global_ba_ms_total = 0;
+  std::vector<LoopEvent> events;
+  std::vector<std::pair<int, double>> global_ba_ms;  // (keyframes, ms) per global BA
+};
+
+class LoopCloser {
+ public:
+  LoopCloser(const SlamSettings& settings, KeyframeDatabase& database, std::vector<double> scales);
+
+  // One keyframe of `map` after local mapping. The caller holds no lock.
+  void process(const std::shared_ptr<Map>& map, const std::shared_ptr<KeyFrame>& kf);
+  const LoopStats& stats() const { return stats_; }
+  // The map tracking works in: another map is merged only into it, so that tracking never finds
+  // its own map emptied under it.
+  void setActiveMap(const std::atomic<Map*>* active) { active_ = active; }
+
+ private:
+  // A recognized place with its covisibility group (keyframe ids), for the consistency test.
+  struct Place {
+    KeyFrame* keyframe;
+    std::vector<Id> group;
+  };
+  using Groups = std::vector<std::pair<std::vector<Id>, int>>;
+  // Places whose group overlaps a group recognized by the previous keyframes often enough in a
+  // row; `groups` becomes this keyframe's groups.
+  std::vector<KeyFrame*> consistentPlaces(const std::vector<Place>& places, Groups& groups) const;
+  struct Verified;
+  bool verify(KeyFrame& kf, KeyFrame& place, Verified& out) const;
+  // Points projected into a keyframe with S_cw that find a keypoint with their descriptor;
+  // `taken` keypoints are skipped and marked.
+  int projectedMatches(const KeyFrame& kf, const Sim3& S_cw, double scale,
+                       const std::vector<std::shared_ptr<MapPoint>>& points, std::vector<bool>* taken) const;
+  struct LoopCorrection;
+  LoopCorrection correctLoop(Map& map, KeyFrame& kf, const Verified& v);
+  void mergeMaps(Map& map, KeyFrame& kf, Map& other, const Verified& v);
+  void optimizeEssentialGraph(Map& map, const LoopCorrection& c, LoopEvent& event);
+  void globalBundleAdjustment(Map& map);
+
+  SlamSettings settings_;
+  KeyframeDatabase& database_;
+  std::vector<double> scales_;
+  // Groups (keyframe ids) that recent keyframes recognized, with how many in a row did.
+  Groups loop_groups_, merge_groups_;
+  int keyframes_since_loop_ = 1000;
+  LoopStats stats_;
+  const std::atomic<Map*>* active_ = nullptr;
+};
+
+}  // namespace hiveslam::core

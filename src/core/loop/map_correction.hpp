@@ -1,0 +1,22 @@
+#pragma once
+// Moving a map to corrected keyframe poses (after an essential graph or a global BA): each
+// keyframe's correction C = S_new^-1 * S_old carries the points it anchors; keyframes the
+// optimization did not see (created meanwhile) inherit the correction of their nearest ancestor
+// in the spanning tree. Culled keyframes follow their parents (KeyFrame::pose). The caller holds the
+// map's mutex.
+#include <unordered_map>
+
+#include "core/geometry/sim3.hpp"
+#include "core/map/map.hpp"
+
+namespace hiveslam::core {
+
+struct PoseCorrection {
+  std::unordered_map<KeyFrame*, Sim3> before, after;  // S_iw of the optimized keyframes
+  // Optimized point positions (global BA); others move with their anchor keyframe.
+  std::unordered_map<MapPoint*, Eigen::Vector3d> points;
+};
+
+void applyCorrection(Map& map, const PoseCorrection& correction, const std::vector<double>& scales);
+
+}  // namespace hiveslam::core

@@ -1,0 +1,74 @@
+#include <gtest/gtest.h>
+
+#include <random>
+
+#include "core/geometry/sim3_solver.hpp"
+#include "core/optim/sim3_refine.hpp"
+
+namespace hiveslam::core {
+namespace {
+
+// Matched points seen from two cameras related by a known similarity (scale 1.7, as monocular
+// maps built at different scales are), 0.5 px noise, 30% of the matches wrong.
+TEST(Sim3Solver, RansacRecoversAKnownSimilarityDespiteOutliers) {
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> u(-1, 1);
+  std::normal_distribution<double> noise(0, 0.5);
+  const Intrinsics K{450, 450, 376, 240};
+  const Sim3 truth(Eigen::Quaterniond(Eigen::AngleAxisd(0.3, Eigen::Vector3d(0.2, 1, 0.1).normalized())),
+                   Eigen::Vector3d(0.4, -0.1, 0.3), 1.7);
+  std::vector<Sim3Match> matches;
+  std::vector<bool> wrong;
+  for (int i = 0; i < 120; ++i) {
+    Sim3Match m;
+    m.p2 = Eigen::Vector3d(1.5 * u(rng), 1.0 * u(rng), 3 + u(rng));
+    m.p1 = truth * m.p2;
+    const bool bad = i % 10 < 3;
+    if (bad) m.p1 = Eigen::Vector3d(2 * u(rng), 1.5 * u(rng), 5 + 2 * u(rng));  // another point
+    m.uv1 = K.project(m.p1) + Eigen::Vector2d(noise(rng), noise(rng));
+    m.uv2 = K.project(m.p2) + Eigen::Vector2d(noise(rng), noise(rng));
+    // The 3D points carry the map's error too (a few percent of depth).
+    m.p1 *= 1 + 0.01 * u(rng);
+    m.p2 *= 1 + 0.01 * u(rng);
+    matches.push_back(m);
+    wrong.push_back(bad);
+  }
+  const Sim3Result r = solveSim3Ransac(K, K, matches);
+  ASSERT_TRUE(r.found);
+  EXPECT_NEAR(r.S12.s, truth.s, 0.05);
+  int false_inliers = 0, true_inliers = 0;
+  for (size_t i = 0; i < matches.size(); ++i) {
+    false_inliers += r.inlier[i] && wrong[i];
+    true_inliers += r.inlier[i] && !wrong[i];
+  }
+  EXPECT_EQ(false_inliers, 0);
+  EXPECT_GE(true_inliers, 75);
+
+  // Refinement on the reprojection errors brings it to the noise level.
+  Sim3 S = r.S12;
+  std::vector<bool> inlier = r.inlier;
+  const int refined = refineSim3(K, K, matches, S, inlier);
+  EXPECT_GE(refined, 75);
+  EXPECT_NEAR(S.s, truth.s, 0.02);
+  EXPECT_LT((S.t - truth.t).norm(), 0.03);
+  EXPECT_LT(S.q.angularDistance(truth.q), 0.005);
+}
+
+TEST(Sim3Solver, RefusesMatchesWithoutACommonSimilarity) {
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> u(-1, 1);
+  const Intrinsics K{450, 450, 376, 240};
+  std::vector<Sim3Match> matches;
+  for (int i = 0; i < 60; ++i) {
+    Sim3Match m;
+    m.p1 = Eigen::Vector3d(1.5 * u(rng), u(rng), 3 + u(rng));
+    m.p2 = Eigen::Vector3d(1.5 * u(rng), u(rng), 3 + u(rng));
+    m.uv1 = K.project(m.p1);
+    m.uv2 = K.project(m.p2);
+    matches.push_back(m);
+  }
+  EXPECT_FALSE(solveSim3Ransac(K, K, matches).found);
+}
+
+}  // namespace
+}  // namespace hiveslam::core
