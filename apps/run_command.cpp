@@ -16,6 +16,7 @@
 #include "eval/resource_monitor.hpp"
 #include "eval/trajectory_error.hpp"
 #include "eval/trajectory_plot.hpp"
+#include "io/atlas_file.hpp"
 #include "io/vocabulary_file.hpp"
 #include "io/open_dataset.hpp"
 #include "io/slam_settings_io.hpp"
@@ -48,8 +49,18 @@ RunSummary runSlam(const RunOptions& o) {
   const auto mode = o.sequential ? core::SlamSystem::Mode::Sequential
                     : o.realtime ? core::SlamSystem::Mode::Realtime
                                  : core::SlamSystem::Mode::Offline;
-  if (o.no_loop_closing) settings.loop_closing = false;
-  core::SlamSystem slam(settings, source->camera().camera, mode, io::loadVocabulary(settings));
+  if (o.no_loop_closing || o.localization) settings.loop_closing = false;
+  if (o.localization && o.atlas_in.empty()) throw InputError("--localization needs --atlas-in FILE");
+  const auto vocabulary = io::loadVocabulary(settings);
+  core::SlamSystem slam(settings, source->camera().camera, mode, vocabulary);
+  if (!o.atlas_in.empty()) {
+    const auto maps = io::loadAtlas(o.atlas_in, vocabulary.get());
+    slam.loadAtlas(maps, o.localization);
+    size_t kfs = 0;
+    for (const auto& m : maps) kfs += m->keyframes.size();
+    fmt::print(stderr, "atlas {}: {} maps, {} keyframes{}\n", o.atlas_in, maps.size(), kfs,
+               o.localization ? " (localization only)" : "");
+  }
   Progress progress("tracking");
   const int total = static_cast<int>(source->size().value_or(0));
   int n = 0, dropped = 0;
@@ -103,6 +114,7 @@ RunSummary runSlam(const RunOptions& o) {
     for (const auto& kf : kfs) keyframes.add(kf->frame.timestamp, kf->T_cw.inverse());
   }
   io::writeTrajectory(out / "trajectory.tum", estimate, io::TrajectoryFormat::Tum);
+  if (!o.atlas_out.empty()) io::saveAtlas(o.atlas_out, slam.liveMaps());
   io::writeTrajectory(out / "keyframes.tum", keyframes, io::TrajectoryFormat::Tum);
 
   nlohmann::json report;
@@ -134,6 +146,7 @@ RunSummary runSlam(const RunOptions& o) {
                            {"global_bas_discarded", ls.global_bas_discarded},
                            {"global_ba_ms", ls.global_ba_ms}};
   report["mode"] = o.sequential ? "sequential" : o.realtime ? "realtime" : "offline";
+  report["localization_only"] = o.localization;
   if (o.realtime) report["dropped_frames"] = dropped;
   report["cpu_seconds"] = monitor.cpuSeconds();
   report["wall_seconds"] = monitor.wallSeconds();
@@ -186,6 +199,9 @@ void addRunCommand(CLI::App& app) {
   cmd->add_flag("--realtime", o->realtime, "Feed frames at their timestamps; tracking never waits for mapping");
   cmd->add_option("--max-frames", o->max_frames, "Stop after this many frames");
   cmd->add_flag("--no-loop-closing", o->no_loop_closing, "Switch loop closing and map merging off");
+  cmd->add_option("--atlas-in", o->atlas_in, "Load the maps of a saved atlas before the run");
+  cmd->add_option("--atlas-out", o->atlas_out, "Save the maps to an atlas file after the run");
+  cmd->add_flag("--localization", o->localization, "Track against --atlas-in without mapping");
   cmd->add_flag("--verbose", o->verbose, "One line per frame instead of the progress line");
   cmd->callback([o]() { fmt::print("{}\n", runSlam(*o).line); });
 }

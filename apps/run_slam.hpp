@@ -12,6 +12,8 @@ struct RunOptions {
   bool verbose = false;
   bool realtime = false;
   bool no_loop_closing = false;
+  std::string atlas_in, atlas_out;  // load maps before the run / save them after it
+  bool localization = false;         // track against atlas_in without mapping
   int max_frames = 0;
 };
 

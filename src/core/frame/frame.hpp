@@ -34,6 +34,9 @@ struct Frame {
   bool inImage(const Eigen::Vector2d& uv) const { return uv.x() >= 0 && uv.y() >= 0 && uv.x() < width && uv.y() < height; }
 
   size_t size() const { return keypoints.size(); }
+  // Builds the grid over `points` (after extraction, or after loading a saved keyframe).
+  void buildGrid();
+  static constexpr double kFarOutside = -1e6;  // where a keypoint with no pinhole image goes
   std::vector<int> inRadius(double x, double y, double r) const { return grid.inRadius(points, x, y, r); }
 };
 

@@ -14,6 +14,14 @@ class IdGenerator {
   explicit IdGenerator(uint16_t node = 0) : node_(node) {}
   Id next() { return (Id{node_} << 48) | counter_.fetch_add(1, std::memory_order_relaxed); }
   static uint16_t node(Id id) { return static_cast<uint16_t>(id >> 48); }
+  // After loading saved maps: this node's next ids come after every id it made before.
+  void advancePast(Id id) {
+    if (node(id) != node_) return;
+    const uint64_t next = (id & ((Id{1} << 48) - 1)) + 1;
+    uint64_t current = counter_.load();
+    while (current < next && !counter_.compare_exchange_weak(current, next)) {
+    }
+  }
 
  private:
   uint16_t node_;

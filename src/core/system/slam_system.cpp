@@ -116,6 +116,25 @@ Eigen::Isometry3d SlamSystem::poseOf(const FrameRecord& r) const {
   return (r.T_c_ref * r.reference->pose()).inverse();
 }
 
+void SlamSystem::loadAtlas(const std::vector<std::shared_ptr<Map>>& maps, bool localization_only) {
+  std::shared_ptr<Map> largest;
+  for (const auto& m : maps) {
+    maps_.push_back(m);
+    ids_.advancePast(m->id);
+    std::lock_guard lock(m->mutex);
+    for (const auto& [id, kf] : m->keyframes) {
+      ids_.advancePast(id);
+      database_.add(kf.get(), m.get());
+    }
+    for (const auto& [id, p] : m->points) ids_.advancePast(id);
+    if (!largest || m->keyframes.size() > largest->keyframes.size()) largest = m;
+  }
+  if (!largest) return;
+  tracker_.setLocalizationOnly(localization_only);
+  tracker_.startInMap(largest);
+  active_map_ = largest.get();
+}
+
 Id SlamSystem::currentMapId(Id map) const {
   for (const auto& m : maps_)
     if (m->id == map) return m->resolve()->id;

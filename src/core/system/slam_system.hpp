@@ -46,6 +46,10 @@ class SlamSystem {
   SlamSystem(const SlamSystem&) = delete;
   SlamSystem& operator=(const SlamSystem&) = delete;
 
+  // Adds saved maps (io/atlas_file) before the first frame: tracking starts by relocalizing in
+  // the largest. With localization_only, no keyframe or map is made: the maps stay as loaded.
+  void loadAtlas(const std::vector<std::shared_ptr<Map>>& maps, bool localization_only);
+
   // Tracks one grey image (and maps its keyframe); returns the frame's record.
   const FrameRecord& process(const cv::Mat& gray, double timestamp);
 

@@ -62,7 +62,7 @@ TrackingOutput Tracker::track(Frame frame, bool mapping_idle) {
     ++lost_frames_;
     // A young map that loses track is abandoned at once; an established one gets a few frames
     // to relocalize before a new map is started.
-    if (keyframes_made_ <= 5 || lost_frames_ > settings_.lost_frames_before_new_map) {
+    if (!localization_only_ && (keyframes_made_ <= 5 || lost_frames_ > settings_.lost_frames_before_new_map)) {
       lock.unlock();
       state_ = TrackingState::NotInitialized;
       init_reference_.reset();
@@ -91,7 +91,7 @@ TrackingOutput Tracker::track(Frame frame, bool mapping_idle) {
     optimize(current);
     out.T_cw = current.T_cw;
   }
-  if (needKeyframe(current, mapping_idle)) {
+  if (!localization_only_ && needKeyframe(current, mapping_idle)) {
     out.new_keyframe = makeKeyframe(current);
     ++keyframes_made_;
     reference_ = out.new_keyframe;
@@ -108,6 +108,18 @@ TrackingOutput Tracker::track(Frame frame, bool mapping_idle) {
     if (current.outlier[i]) current.points[i].reset();
   last_ = std::move(current);
   return out;
+}
+
+void Tracker::startInMap(const std::shared_ptr<Map>& map) {
+  map_ = map;
+  state_ = TrackingState::Lost;
+  keyframes_made_ = static_cast<int>(map->keyframes.size());
+  lost_frames_ = 0;
+  last_.reset();
+  reference_.reset();
+  last_reference_.reset();
+  epoch_seen_ = map->epoch;
+  have_velocity_ = false;
 }
 
 bool Tracker::initialize(Tracked& current, TrackingOutput& out) {

@@ -42,6 +42,10 @@ class Tracker {
     vocabulary_ = vocabulary;
     database_ = database;
   }
+  // Starts lost in a loaded map: the next frames relocalize in it.
+  void startInMap(const std::shared_ptr<Map>& map);
+  // Localization only: track against the map, never make keyframes or new maps.
+  void setLocalizationOnly(bool on) { localization_only_ = on; }
   TrackingState state() const { return state_; }
   int failures() const { return failures_; }
   const std::shared_ptr<Map>& map() const { return map_; }
@@ -90,6 +94,7 @@ class Tracker {
   std::shared_ptr<KeyFrame> last_reference_;
   Eigen::Isometry3d last_T_c_ref_ = Eigen::Isometry3d::Identity();
   uint64_t epoch_seen_ = 0;
+  bool localization_only_ = false;
 };
 
 }  // namespace hiveslam::core
