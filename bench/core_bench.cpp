@@ -8,7 +8,10 @@
 #include <random>
 
 #include "core/frame/frame.hpp"
+#include "core/geometry/sim3_solver.hpp"
+#include "core/optim/pose_graph.hpp"
 #include "core/optim/pose_optimizer.hpp"
+#include "core/place/vocabulary.hpp"
 #include "synth/sequence.hpp"
 
 namespace {
@@ -65,6 +68,73 @@ void PoseOptimize(benchmark::State& state) {
   }
 }
 BENCHMARK(PoseOptimize)->Arg(300)->Arg(1000)->Unit(benchmark::kMicrosecond);
+
+// Bag of words of one image's 1000 descriptors with the shipped vocabulary.
+void VocabularyTransform(benchmark::State& state) {
+  static const auto voc =
+      hiveslam::place::Vocabulary::load(std::string(HIVESLAM_SOURCE_DIR) + "/data/vocabulary/orb_k10_l4.bin");
+  const hiveslam::features::OrbExtractor orb;
+  std::vector<cv::KeyPoint> kps;
+  cv::Mat desc;
+  orb.extract(image(), kps, desc);
+  hiveslam::place::BowVector bow;
+  hiveslam::place::FeatureVector fv;
+  for (auto _ : state) voc.transform(desc, bow, fv);
+  state.counters["words"] = static_cast<double>(bow.size());
+}
+BENCHMARK(VocabularyTransform)->Unit(benchmark::kMillisecond);
+
+// Sim3 RANSAC on N 3D-3D matches of which 30% are wrong (what loop verification solves).
+void Sim3Ransac(benchmark::State& state) {
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> u(-1, 1);
+  const hiveslam::core::Intrinsics K{450, 450, 376, 240};
+  const hiveslam::core::Sim3 S(Eigen::Quaterniond(Eigen::AngleAxisd(0.3, Eigen::Vector3d::UnitY())),
+                               Eigen::Vector3d(0.3, 0, 0.1), 1.4);
+  std::vector<hiveslam::core::Sim3Match> m;
+  for (int i = 0; i < state.range(0); ++i) {
+    hiveslam::core::Sim3Match x;
+    x.p2 = Eigen::Vector3d(u(rng), u(rng), 3 + u(rng));
+    x.p1 = i % 10 < 3 ? Eigen::Vector3d(u(rng), u(rng), 4 + u(rng)) : S * x.p2;
+    x.uv1 = K.project(x.p1);
+    x.uv2 = K.project(x.p2);
+    m.push_back(x);
+  }
+  for (auto _ : state) benchmark::DoNotOptimize(hiveslam::core::solveSim3Ransac(K, K, m));
+}
+BENCHMARK(Sim3Ransac)->Arg(50)->Arg(200)->Unit(benchmark::kMicrosecond);
+
+// Essential graph of N keyframes around a circle: a chain plus covisibility edges to the next
+// three, one loop edge, drift to spread.
+void EssentialGraph(benchmark::State& state) {
+  const int n = static_cast<int>(state.range(0));
+  std::vector<hiveslam::core::Sim3> truth;
+  for (int i = 0; i < n; ++i) {
+    const double a = 2 * M_PI * i / n;
+    Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+    T.linear() = Eigen::AngleAxisd(a, Eigen::Vector3d::UnitY()).toRotationMatrix();
+    T.translation() = Eigen::Vector3d(2 * std::cos(a), 0, 2 * std::sin(a));
+    truth.push_back(hiveslam::core::Sim3(T.inverse()));
+  }
+  const hiveslam::core::Sim3 drift(Eigen::Quaterniond(Eigen::AngleAxisd(0.002, Eigen::Vector3d::UnitY())),
+                                   Eigen::Vector3d(0.005, 0, 0), 1.005);
+  hiveslam::core::PoseGraph g0;
+  g0.poses.push_back(truth[0]);
+  g0.fixed.push_back(true);
+  for (int i = 1; i < n; ++i) {
+    g0.poses.push_back(drift * (truth[static_cast<size_t>(i)] * truth[static_cast<size_t>(i - 1)].inverse()) * g0.poses.back());
+    g0.fixed.push_back(false);
+  }
+  for (int i = 1; i < n; ++i)
+    for (int k = 1; k <= 3 && i - k >= 0; ++k)
+      g0.edges.push_back({i, i - k, g0.poses[static_cast<size_t>(i)] * g0.poses[static_cast<size_t>(i - k)].inverse(), 1.0});
+  g0.edges.push_back({0, n - 1, truth[0] * truth[static_cast<size_t>(n - 1)].inverse(), 1.0});
+  for (auto _ : state) {
+    hiveslam::core::PoseGraph g = g0;
+    hiveslam::core::optimizePoseGraph(g, 20);
+  }
+}
+BENCHMARK(EssentialGraph)->Arg(100)->Arg(300)->Unit(benchmark::kMillisecond);
 
 }  // namespace
 

@@ -102,6 +102,15 @@ TEST(SlamSystem, MergesTheMapsAcrossABlankSegment) {
   EXPECT_LT(ate.stats.rmse, 0.01 * ate.reference_length) << ate.stats.rmse << " m over " << ate.reference_length;
 }
 
+// Along one wall and back along the other: every place looks alike (the same texture statistics
+// everywhere) but none is visited twice, so nothing may be closed or merged.
+TEST(SlamSystem, ClosesNoLoopOnASequenceThatNeverRevisits) {
+  const SlamRun run = runSequence("sweep", 400, 0, 400, 3, SlamSystem::Mode::Sequential, shippedVocabulary());
+  EXPECT_GE(run.tracked, 0.9 * run.frames);
+  EXPECT_EQ(run.loops, 0);
+  EXPECT_EQ(run.merges, 0);
+}
+
 TEST(SlamSystem, SequentialModeIsDeterministic) {
   const SlamRun a = runSequence("sweep", 600, 100, 80, 4, SlamSystem::Mode::Sequential), b = runSequence("sweep", 600, 100, 80, 4, SlamSystem::Mode::Sequential);
   ASSERT_EQ(a.estimate.size(), b.estimate.size());

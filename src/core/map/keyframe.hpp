@@ -38,6 +38,11 @@ class KeyFrame : public std::enable_shared_from_this<KeyFrame> {
   // A culled keyframe keeps its pose relative to its parent (set when it leaves the map): frames
   // tracked against it follow every later correction of the map through pose().
   Eigen::Isometry3d T_c_parent = Eigen::Isometry3d::Identity();
+  // Where tracking posed it: the map's epoch then and its pose relative to tracking's reference
+  // keyframe. A keyframe that waited in the queue through a correction is re-posed from these.
+  uint64_t made_in_epoch = 0;
+  KeyFrame* made_from = nullptr;
+  Eigen::Isometry3d T_made_from = Eigen::Isometry3d::Identity();
   // The current pose: T_cw, or for a culled keyframe its pose through the spanning tree.
   Eigen::Isometry3d pose() const {
     return bad && parent ? T_c_parent * parent->pose() : T_cw;

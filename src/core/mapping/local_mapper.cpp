@@ -57,6 +57,10 @@ void LocalMapper::process(const std::shared_ptr<Map>& map, const std::shared_ptr
 }
 
 void LocalMapper::insert(Map& map, KeyFrame& kf) {
+  // The map moved (loop correction, global BA) while this keyframe waited in the queue: it
+  // moves with the keyframe tracking posed it against.
+  if (kf.made_in_epoch != map.epoch && kf.made_from) kf.T_cw = kf.T_made_from * kf.made_from->pose();
+  kf.made_in_epoch = map.epoch;
   if (!map.keyframes.count(kf.id)) map.add(kf.shared_from_this());
   for (size_t i = 0; i < kf.points.size(); ++i) {
     auto& p = kf.points[i];
@@ -120,22 +124,16 @@ void LocalMapper::triangulateNewPoints(Map& map, KeyFrame& kf) {
       const Eigen::Vector3d l2 = F21 * kf.frame.points[i].homogeneous();
       const double norm2 = l2.head<2>().squaredNorm();
       const uchar* d1 = kf.frame.descriptors.ptr<uchar>(static_cast<int>(i));
-      int best = 256, second = 256, best_j = -1;
+      features::NearestTwo near;
       for (size_t j = 0; j < nb->points.size(); ++j) {
         if (nb->points[j] || taken[j]) continue;
         const double e = nb->frame.points[j].homogeneous().dot(l2);
         const double s2 = scales_[static_cast<size_t>(nb->frame.keypoints[j].octave)];
         if (e * e / norm2 > 3.84 * s2 * s2) continue;
-        const int d = features::hamming(d1, nb->frame.descriptors.ptr<uchar>(static_cast<int>(j)));
-        if (d < best) {
-          second = best;
-          best = d;
-          best_j = static_cast<int>(j);
-        } else if (d < second) {
-          second = d;
-        }
+        near.offer(features::hamming(d1, nb->frame.descriptors.ptr<uchar>(static_cast<int>(j))), static_cast<int>(j));
       }
-      if (best_j < 0 || best > kMatchLow || best >= 0.7 * second) continue;
+      if (!near.accepted(kMatchLow, 0.7)) continue;
+      const int best_j = near.index;
       taken[static_cast<size_t>(best_j)] = 1;
       hist.add(kf.frame.keypoints[i].angle, nb->frame.keypoints[static_cast<size_t>(best_j)].angle,
                static_cast<int>(pairs.size()));

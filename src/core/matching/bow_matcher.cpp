@@ -32,19 +32,11 @@ std::vector<std::pair<int, int>> matchByNodes(const place::FeatureVector& fa, co
     }
     for (int i : ia->second) {
       if (!usable_a(i)) continue;
-      int best = 256, second = 256, best_j = -1;
-      for (int j : ib->second) {
-        if (!usable_b(j) || taken_b[static_cast<size_t>(j)]) continue;
-        const int d = features::hamming(da.ptr<uchar>(i), db.ptr<uchar>(j));
-        if (d < best) {
-          second = best;
-          best = d;
-          best_j = j;
-        } else if (d < second) {
-          second = d;
-        }
-      }
-      if (best_j < 0 || best > kMatchLow || best >= ratio * second) continue;
+      features::NearestTwo near;
+      for (int j : ib->second)
+        if (usable_b(j) && !taken_b[static_cast<size_t>(j)]) near.offer(features::hamming(da.ptr<uchar>(i), db.ptr<uchar>(j)), j);
+      if (!near.accepted(kMatchLow, ratio)) continue;
+      const int best_j = near.index;
       taken_b[static_cast<size_t>(best_j)] = 1;
       hist.add(ka[static_cast<size_t>(i)].angle, kb[static_cast<size_t>(best_j)].angle, static_cast<int>(pairs.size()));
       pairs.emplace_back(i, best_j);

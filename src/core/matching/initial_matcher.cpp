@@ -15,23 +15,18 @@ std::vector<int> matchForInitialization(const Frame& f1, const Frame& f2, const 
   for (size_t i = 0; i < f1.size(); ++i) {
     const auto& kp = f1.keypoints[i];
     const auto& p = around ? (*around)[i] : f1.points[i];
-    int best = std::numeric_limits<int>::max(), second = best, best_j = -1;
+    features::NearestTwo near;
     for (int j : f2.inRadius(p.x(), p.y(), o.radius)) {
       if (f2.keypoints[static_cast<size_t>(j)].octave != kp.octave) continue;
       const int d = features::hamming(f1.descriptors.ptr<uchar>(static_cast<int>(i)), f2.descriptors.ptr<uchar>(j));
       if (d > dist21[static_cast<size_t>(j)]) continue;  // f2's keypoint already has a closer match
-      if (d < best) {
-        second = best;
-        best = d;
-        best_j = j;
-      } else if (d < second) {
-        second = d;
-      }
+      near.offer(d, j);
     }
-    if (best_j < 0 || best > o.max_distance || best >= o.ratio * second) continue;
-    const size_t j = static_cast<size_t>(best_j);
+    if (!near.accepted(o.max_distance, o.ratio)) continue;
+    const int best = near.best;
+    const size_t j = static_cast<size_t>(near.index);
     if (match21[j] >= 0) match12[static_cast<size_t>(match21[j])] = -1;  // displaced
-    match12[i] = best_j;
+    match12[i] = near.index;
     match21[j] = static_cast<int>(i);
     dist21[j] = best;
   }

@@ -374,19 +374,11 @@ bool Tracker::relocalize(Tracked& c) {
       for (size_t j = 0; j < kf.points.size(); ++j) {
         const auto& p = kf.points[j];
         if (!p || p->bad) continue;
-        int best = 256, second = 256, best_i = -1;
-        for (int i = 0; i < static_cast<int>(c.frame.size()); ++i) {
-          const int d = features::hamming(p->descriptor.ptr<uchar>(), c.frame.descriptors.ptr<uchar>(i));
-          if (d < best) {
-            second = best;
-            best = d;
-            best_i = i;
-          } else if (d < second) {
-            second = d;
-          }
-        }
-        if (best_i < 0 || best > kMatchLow || best > 0.75 * second || slots[static_cast<size_t>(best_i)]) continue;
-        add(best_i, p);
+        features::NearestTwo near;
+        for (int i = 0; i < static_cast<int>(c.frame.size()); ++i)
+          near.offer(features::hamming(p->descriptor.ptr<uchar>(), c.frame.descriptors.ptr<uchar>(i)), i);
+        if (!near.accepted(kMatchLow, 0.75) || slots[static_cast<size_t>(near.index)]) continue;
+        add(near.index, p);
       }
     }
     if (object.size() < 15) continue;
@@ -435,6 +427,11 @@ void Tracker::describePlace(KeyFrame& kf) const {
 std::shared_ptr<KeyFrame> Tracker::makeKeyframe(const Tracked& c) {
   auto kf = std::make_shared<KeyFrame>(ids_.next(), c.frame, c.T_cw);
   describePlace(*kf);
+  kf->made_in_epoch = map_->epoch;
+  if (reference_) {
+    kf->made_from = reference_.get();
+    kf->T_made_from = c.T_cw * reference_->pose().inverse();
+  }
   for (size_t i = 0; i < c.points.size(); ++i)
     if (c.points[i] && !c.outlier[i] && !c.points[i]->bad) kf->points[i] = c.points[i];
   return kf;
