@@ -217,11 +217,20 @@ LocalMapper::LocalBa LocalMapper::prepareLocalBa(Map& map, KeyFrame& kf) {
     pose_index[k] = static_cast<int>(ba.poses.size());
     ba.poses.push_back({Eigen::Quaterniond(k->T_cw.linear()), k->T_cw.translation(), true});
   }
-  // With a monocular gauge, at least two fixed poses keep the scale: fix the oldest local one
-  // too when the window has no other anchor.
-  if (fixed.empty() && local.size() > 1) {
-    KeyFrame* oldest = *std::min_element(local.begin(), local.end(), [](KeyFrame* a, KeyFrame* b) { return a->id < b->id; });
-    ba.poses[static_cast<size_t>(pose_index[oldest])].fixed = true;
+  // Monocular gauge: one fixed pose leaves the scale free (scaling everything about that camera
+  // changes no reprojection error), and a free scale wanders; two fixed poses hold it. When the
+  // border does not provide two, the oldest keyframes of the window are held as well.
+  int fixed_count = 0;
+  for (const auto& pose : ba.poses) fixed_count += pose.fixed;
+  std::vector<KeyFrame*> by_age = local;
+  std::sort(by_age.begin(), by_age.end(), [](KeyFrame* a, KeyFrame* b) { return a->id < b->id; });
+  for (KeyFrame* k : by_age) {
+    if (fixed_count >= 2 || k == &kf) break;
+    auto& pose = ba.poses[static_cast<size_t>(pose_index[k])];
+    if (!pose.fixed) {
+      pose.fixed = true;
+      ++fixed_count;
+    }
   }
   std::vector<std::pair<KeyFrame*, MapPoint*>> obs_refs;
   for (size_t i = 0; i < pts.size(); ++i) {
