@@ -36,11 +36,13 @@ void addDemoCommand(CLI::App& app) {
     };
     fmt::print("\n{:<28} {}\n", "sequence", fmt::format("{} ({} frames, {:.1f} m, rendered in {:.1f} s)", seq.string(),
                                                          rendered.frames, rendered.path_length, rendered.render_seconds));
-    fmt::print("{:<28} {}\n", "configuration", "1 node (standalone: tracking + local mapping threads)");
+    fmt::print("{:<28} {}\n", "configuration", "1 node (standalone: tracking, local mapping, loop closing threads)");
     fmt::print("{:<28} {:.0f} of {:.0f} ({:.1f}%)\n", "tracked frames", num("tracked_frames"), num("frames"),
                100.0 * num("tracked_frames") / std::max(num("frames"), 1.0));
     fmt::print("{:<28} {:.0f}\n", "failures", num("failures"));
     fmt::print("{:<28} {:.0f} in {:.0f} map(s)\n", "keyframes", num("keyframes"), num("maps"));
+    fmt::print("{:<28} {:.0f} loop(s), {:.0f} merge(s), {:.0f} global BA(s)\n", "loop closing", num("loops"),
+               num("merges"), num("global_bas"));
     if (r.contains("ate"))
       fmt::print("{:<28} {:.4f} m ({:.2f}% of {:.1f} m)\n", "ATE RMSE (Sim3)", num("ate", "rmse"),
                  num("ate", "percent_of_path"), num("ate", "path_length"));
