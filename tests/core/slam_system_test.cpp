@@ -111,6 +111,31 @@ TEST(SlamSystem, ClosesNoLoopOnASequenceThatNeverRevisits) {
   EXPECT_EQ(run.merges, 0);
 }
 
+// Kidnapped: after 120 frames the camera jumps back to where it was at frame 40. Tracking must
+// lose the pose, find the place again through the keyframe database and go on in the same map.
+TEST(SlamSystem, RelocalizesAfterAJumpBackWithoutLoopClosing) {
+  synth::SequenceOptions o;
+  o.trajectory = "sweep";
+  o.frames = 600;
+  o.seed = 4;
+  const auto model = synth::buildSequence(o);
+  const synth::RayTable rays(model.lens);
+  auto camera = std::make_shared<camera::PinholeRadTan>(model.lens.width, model.lens.height, model.lens.fx,
+                                                        model.lens.fy, model.lens.cx, model.lens.cy);
+  SlamSettings settings;
+  settings.loop_closing = false;
+  SlamSystem slam(settings, camera, SlamSystem::Mode::Sequential, shippedVocabulary());
+  double t = 0;
+  for (int f = 0; f < 120; ++f) slam.process(model.renderImage(f, rays), t += 0.05);
+  ASSERT_TRUE(slam.frames().back().tracked);
+  int tracked_after_jump = 0;
+  for (int f = 40; f < 60; ++f) tracked_after_jump += slam.process(model.renderImage(f, rays), t += 0.05).tracked;
+  slam.finish();
+  EXPECT_GE(tracked_after_jump, 15);
+  EXPECT_EQ(slam.liveMaps().size(), 1u);
+  EXPECT_GE(slam.failures(), 1);
+}
+
 TEST(SlamSystem, SequentialModeIsDeterministic) {
   const SlamRun a = runSequence("sweep", 600, 100, 80, 4, SlamSystem::Mode::Sequential), b = runSequence("sweep", 600, 100, 80, 4, SlamSystem::Mode::Sequential);
   ASSERT_EQ(a.estimate.size(), b.estimate.size());

@@ -211,10 +211,11 @@ void LoopCloser::process(const std::shared_ptr<Map>& map_handle, const std::shar
     }
     if (kf.covisibility.empty()) min_score = 0;
     const auto candidates = database_.query(kf.bow, exclude);
-    database_.add(&kf, &map);
     std::map<KeyFrame*, double> same_map;
     for (const auto& c : candidates) {
-      if (c.score < min_score) continue;
+      // Local mapping runs ahead of this module: keyframes newer than this one are never the
+      // place it returns to.
+      if (c.score < min_score || c.keyframe->id > kf.id) continue;
       if (c.map == &map) {
         if (!c.keyframe->bad) same_map[c.keyframe] = c.score;
       } else {

@@ -61,7 +61,12 @@ void LocalMapper::insert(Map& map, KeyFrame& kf) {
   // moves with the keyframe tracking posed it against.
   if (kf.made_in_epoch != map.epoch && kf.made_from) kf.T_cw = kf.T_made_from * kf.made_from->pose();
   kf.made_in_epoch = map.epoch;
-  if (!map.keyframes.count(kf.id)) map.add(kf.shared_from_this());
+  if (!map.keyframes.count(kf.id)) {
+    map.add(kf.shared_from_this());
+    // In the database as soon as it is in the map: relocalization finds it even without loop
+    // closing.
+    if (database_) database_->add(&kf, &map);
+  }
   for (size_t i = 0; i < kf.points.size(); ++i) {
     auto& p = kf.points[i];
     if (!p) continue;

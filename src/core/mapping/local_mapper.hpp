@@ -26,7 +26,7 @@ class LocalMapper {
   void process(const std::shared_ptr<Map>& map, const std::shared_ptr<KeyFrame>& kf,
                const std::atomic<bool>* abort_ba = nullptr);
   const MappingStats& stats() const { return stats_; }
-  // Culled keyframes leave the place recognition database too.
+  // Inserted keyframes enter the place recognition database, culled ones leave it.
   void setDatabase(KeyframeDatabase* database) { database_ = database; }
 
  private:
