@@ -1,6 +1,9 @@
 #include "io/vocabulary_file.hpp"
 
 #include <cstdlib>
+#include <string>
+
+#include "common/error.hpp"
 
 namespace hiveslam::io {
 
@@ -11,7 +14,11 @@ std::filesystem::path vocabularyPath(const core::SlamSettings& settings) {
 }
 
 std::shared_ptr<const place::Vocabulary> loadVocabulary(const core::SlamSettings& settings) {
-  return std::make_shared<const place::Vocabulary>(place::Vocabulary::load(vocabularyPath(settings)));
+  try {
+    return std::make_shared<const place::Vocabulary>(place::Vocabulary::load(vocabularyPath(settings)));
+  } catch (const InputError& e) {
+    throw InputError(std::string(e.what()) + " (name one with the 'vocabulary' setting or HIVESLAM_VOCABULARY)");
+  }
 }
 
 }  // namespace hiveslam::io
