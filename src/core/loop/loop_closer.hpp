@@ -30,7 +30,7 @@ struct LoopEvent {
   Id map = kNoId, merged_map = kNoId;
   int matches = 0;
   double scale = 1.0;   // scale of the correcting Sim3 (drift seen at the loop)
-  double detect_ms = 0, correct_ms = 0, essential_graph_ms = 0;
+  double correct_ms = 0, essential_graph_ms = 0;  // detection to corrected loop; pose graph
 };
 
 struct LoopStats {

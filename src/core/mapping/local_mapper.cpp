@@ -1,5 +1,7 @@
 #include "core/mapping/local_mapper.hpp"
 
+#include "core/geometry/skew.hpp"
+
 #include <cmath>
 #include <set>
 
@@ -11,16 +13,6 @@
 #include "core/optim/bundle_adjustment.hpp"
 
 namespace hiveslam::core {
-
-namespace {
-
-Eigen::Matrix3d skew(const Eigen::Vector3d& v) {
-  Eigen::Matrix3d m;
-  m << 0, -v.z(), v.y(), v.z(), 0, -v.x(), -v.y(), v.x(), 0;
-  return m;
-}
-
-}  // namespace
 
 LocalMapper::LocalMapper(const SlamSettings& settings, IdGenerator& ids, std::vector<double> scales)
     : settings_(settings), ids_(ids), scales_(std::move(scales)) {}

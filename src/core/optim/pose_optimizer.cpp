@@ -1,5 +1,7 @@
 #include "core/optim/pose_optimizer.hpp"
 
+#include "core/geometry/skew.hpp"
+
 #include <Eigen/Cholesky>
 #include <cmath>
 #include <limits>
@@ -11,12 +13,6 @@ namespace {
 constexpr double kChi2 = 5.991;  // 95% of chi-square with 2 degrees of freedom
 constexpr int kRounds = 4;
 constexpr int kIterations = 10;
-
-Eigen::Matrix3d skew(const Eigen::Vector3d& v) {
-  Eigen::Matrix3d m;
-  m << 0, -v.z(), v.y(), v.z(), 0, -v.x(), -v.y(), v.x(), 0;
-  return m;
-}
 
 // exp of an se(3) twist (rotation first, then translation), enough for small steps.
 Eigen::Isometry3d expSE3(const Eigen::Matrix<double, 6, 1>& d) {
