@@ -11,5 +11,8 @@ void addInfoCommand(CLI::App& app);
 void addDemoCommand(CLI::App& app);
 void addRunCommand(CLI::App& app);
 void addVocabCommand(CLI::App& app);
+void addNodeCommand(CLI::App& app);
+void addClusterCommand(CLI::App& app);
+void addBenchCommand(CLI::App& app);
 
 }  // namespace hiveslam::apps

@@ -22,6 +22,8 @@ int main(int argc, char** argv) {
   hiveslam::apps::addDemoCommand(app);
   hiveslam::apps::addRunCommand(app);
   hiveslam::apps::addVocabCommand(app);
+  hiveslam::apps::addNodeCommand(app);
+  hiveslam::apps::addClusterCommand(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -1,5 +1,6 @@
 // hiveslam run DATASET --out DIR: the standalone SLAM system on any input the readers know.
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include <algorithm>
 #include <filesystem>
@@ -12,6 +13,8 @@
 #include "apps/run_slam.hpp"
 #include "apps/progress.hpp"
 #include "common/error.hpp"
+#include "communication/dds/dds_transport.hpp"
+#include "distribution/distributed_node.hpp"
 #include "core/system/slam_system.hpp"
 #include "eval/resource_monitor.hpp"
 #include "eval/trajectory_error.hpp"
@@ -52,7 +55,28 @@ RunSummary runSlam(const RunOptions& o) {
   if (o.no_loop_closing || o.localization) settings.loop_closing = false;
   if (o.localization && o.atlas_in.empty()) throw InputError("--localization needs --atlas-in FILE");
   const auto vocabulary = io::loadVocabulary(settings);
-  core::SlamSystem slam(settings, source->camera().camera, mode, vocabulary);
+  core::SlamSystem slam(settings, source->camera().camera, mode, vocabulary, o.network.enabled ? o.network.id : 0);
+  // The distributed TR node: the same system, with the distribution layer on its seam.
+  std::unique_ptr<communication::DdsTransport> transport;
+  std::unique_ptr<distribution::DistributedNode> node;
+  if (o.network.enabled) {
+    transport = std::make_unique<communication::DdsTransport>(communication::DdsOptions{o.network.domain});
+    node = std::make_unique<distribution::DistributedNode>(
+        slam, *transport, distribution::NodeOptions{communication::Task::Tracking, o.network.id, o.network.name, {}});
+    node->start();
+    uint8_t want = 0;
+    for (const auto& t : o.network.expect) {
+      communication::Task task;
+      if (!communication::parseTask(t, task)) throw InputError("unknown task '" + t + "' (tr, lm or lc)");
+      want |= communication::taskBit(task);
+    }
+    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(o.network.wait_seconds);
+    while ((node->presentTasks() & want) != want && std::chrono::steady_clock::now() < deadline)
+      std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    if ((node->presentTasks() & want) != want)
+      throw InputError(fmt::format("the expected peers ({}) did not appear within {} s on DDS domain {}",
+                                   fmt::join(o.network.expect, ","), o.network.wait_seconds, o.network.domain));
+  }
   if (!o.atlas_in.empty()) {
     const auto maps = io::loadAtlas(o.atlas_in, vocabulary.get());
     slam.loadAtlas(maps, o.localization);
@@ -90,6 +114,13 @@ RunSummary runSlam(const RunOptions& o) {
       progress.update(++n, std::max(total, n));
     if (o.verbose) ++n;
     if (o.max_frames > 0 && n >= o.max_frames) break;
+  }
+  nlohmann::json node_report;
+  if (node) {
+    if (!node->finishRun(std::chrono::seconds(120)))
+      fmt::print(stderr, "warning: the end-of-run exchange did not complete; the maps may differ between nodes\n");
+    node_report = node->report(monitor.wallSeconds());
+    node->stop();
   }
   slam.finish();
 
@@ -178,6 +209,7 @@ RunSummary runSlam(const RunOptions& o) {
       ate_line = std::string("ATE not computed: ") + e.what();
     }
   }
+  if (node) report.update(node_report);
   std::ofstream(out / "report.json") << report.dump(2) << "\n";
   RunSummary summary;
   summary.report = report;

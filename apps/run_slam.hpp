@@ -3,6 +3,7 @@
 // report.json and plot out.
 #include <nlohmann/json.hpp>
 #include <string>
+#include <vector>
 
 namespace hiveslam::apps {
 
@@ -15,6 +16,16 @@ struct RunOptions {
   std::string atlas_in, atlas_out;  // load maps before the run / save them after it
   bool localization = false;         // track against atlas_in without mapping
   int max_frames = 0;
+  // As the TR node of a distributed system (hiveslam node --task tr): on a DDS domain, waiting
+  // for the peers it expects before the first frame.
+  struct Network {
+    bool enabled = false;
+    int domain = 0;
+    uint16_t id = 1;
+    std::string name = "tr";
+    std::vector<std::string> expect;  // tasks of the peers to wait for ("lm", "lc")
+    int wait_seconds = 20;
+  } network;
 };
 
 struct RunSummary {

@@ -279,6 +279,7 @@ void LoopCloser::process(const std::shared_ptr<Map>& map_handle, const std::shar
       loop_groups_.clear();
       keyframes_since_loop_ = 0;
       stats_.events.back().correct_ms = msSince(t0);
+      report(GlobalUpdate::Kind::Merge, map.id, other->id);
       globalBundleAdjustment(map);
       return;
     }
@@ -307,6 +308,7 @@ void LoopCloser::process(const std::shared_ptr<Map>& map_handle, const std::shar
     optimizeEssentialGraph(map, c, event);
     stats_.events.push_back(event);
     ++stats_.loops;
+    report(GlobalUpdate::Kind::Loop, map.id);
     loop_groups_.clear();
     keyframes_since_loop_ = 0;
     globalBundleAdjustment(map);
@@ -461,6 +463,7 @@ void LoopCloser::globalBundleAdjustment(Map& map) {
     applyCorrection(map, correction, scales_);
   }
   ++stats_.global_bas;
+  report(GlobalUpdate::Kind::GlobalBa, map.id);
   const double ms = msSince(t0);
   stats_.global_ba_ms_total += ms;
   stats_.global_ba_ms.emplace_back(static_cast<int>(kfs.size()), ms);

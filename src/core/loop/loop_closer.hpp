@@ -10,6 +10,7 @@
 // map mutex and are applied under it, bumping the map's epoch (see map.hpp). The merge is the
 // one step that holds two maps' mutexes, taken together by std::scoped_lock.
 #include <atomic>
+#include <functional>
 #include <map>
 #include <memory>
 #include <set>
@@ -41,6 +42,13 @@ struct LoopStats {
   std::vector<std::pair<int, double>> global_ba_ms;  // (keyframes, ms) per global BA
 };
 
+// A change of a map's coordinate frame, reported to the distribution layer.
+struct GlobalUpdate {
+  enum class Kind { Loop, Merge, GlobalBa } kind = Kind::Loop;
+  Id map = kNoId;
+  Id merged_map = kNoId;  // for a merge: the map that now lives in `map`
+};
+
 class LoopCloser {
  public:
   LoopCloser(const SlamSettings& settings, KeyframeDatabase& database, std::vector<double> scales);
@@ -51,6 +59,8 @@ class LoopCloser {
   // The map tracking works in: another map is merged only into it, so that tracking never finds
   // its own map emptied under it.
   void setActiveMap(const std::atomic<Map*>* active) { active_ = active; }
+  // Called on the loop closing thread, without any lock, after each global update is applied.
+  void setOnGlobalUpdate(std::function<void(const GlobalUpdate&)> f) { on_update_ = std::move(f); }
 
  private:
   // A recognized place with its covisibility group (keyframe ids), for the consistency test.
@@ -82,6 +92,10 @@ class LoopCloser {
   int keyframes_since_loop_ = 1000;
   LoopStats stats_;
   const std::atomic<Map*>* active_ = nullptr;
+  std::function<void(const GlobalUpdate&)> on_update_;
+  void report(GlobalUpdate::Kind kind, Id map, Id merged = kNoId) const {
+    if (on_update_) on_update_({kind, map, merged});
+  }
 };
 
 }  // namespace hiveslam::core

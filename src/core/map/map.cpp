@@ -14,6 +14,7 @@ void Map::erase(MapPoint& p) {
   if (auto it = points.find(p.id); it != points.end()) {
     erased_points.push_back(it->second);
     points.erase(it);
+    if (journal_on) journal.erased_points.push_back(p.id);
   }
 }
 
@@ -33,6 +34,7 @@ void Map::replace(MapPoint& old, const std::shared_ptr<MapPoint>& by) {
   if (auto it = points.find(old.id); it != points.end()) {
     erased_points.push_back(it->second);
     points.erase(it);
+    if (journal_on) journal.replaced_points.emplace_back(old.id, by->id);
   }
 }
 
@@ -58,6 +60,7 @@ void Map::erase(KeyFrame& kf) {
   if (auto it = keyframes.find(kf.id); it != keyframes.end()) {
     retired.push_back(it->second);
     keyframes.erase(it);
+    if (journal_on) journal.erased_keyframes.push_back(kf.id);
   }
 }
 

@@ -42,6 +42,15 @@ class Map {
   // pointer or reference to one within the step that erased it.
   std::vector<std::shared_ptr<MapPoint>> erased_points;
   void collectGarbage() { erased_points.clear(); }
+  // What left the map, recorded for the distribution layer (which ships it to the other nodes
+  // and clears it) when `journal_on`. Standalone runs leave it off.
+  struct Journal {
+    std::vector<Id> erased_keyframes, erased_points;
+    std::vector<std::pair<Id, Id>> replaced_points;  // (old, by) from duplicate fusion
+    bool empty() const { return erased_keyframes.empty() && erased_points.empty() && replaced_points.empty(); }
+  };
+  bool journal_on = false;
+  Journal journal;
 
   void add(const std::shared_ptr<KeyFrame>& kf) { keyframes[kf->id] = kf; }
   void add(const std::shared_ptr<MapPoint>& p) { points[p->id] = p; }

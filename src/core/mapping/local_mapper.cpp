@@ -8,6 +8,7 @@
 #include "core/features/hamming.hpp"
 #include "core/features/rotation_histogram.hpp"
 #include "core/geometry/triangulation.hpp"
+#include "core/mapping/keyframe_insertion.hpp"
 #include "core/matching/fusion.hpp"
 #include "core/matching/projection_matcher.hpp"
 #include "core/optim/bundle_adjustment.hpp"
@@ -49,29 +50,8 @@ void LocalMapper::process(const std::shared_ptr<Map>& map, const std::shared_ptr
 }
 
 void LocalMapper::insert(Map& map, KeyFrame& kf) {
-  // The map moved (loop correction, global BA) while this keyframe waited in the queue: it
-  // moves with the keyframe tracking posed it against.
-  if (kf.made_in_epoch != map.epoch && kf.made_from) kf.T_cw = kf.T_made_from * kf.made_from->pose();
-  kf.made_in_epoch = map.epoch;
-  if (!map.keyframes.count(kf.id)) {
-    map.add(kf.shared_from_this());
-    // In the database as soon as it is in the map: relocalization finds it even without loop
-    // closing.
-    if (database_) database_->add(&kf, &map);
-  }
-  for (size_t i = 0; i < kf.points.size(); ++i) {
-    auto& p = kf.points[i];
-    if (!p) continue;
-    if (p->bad) {
-      p.reset();
-      continue;
-    }
-    if (!p->observations.count(&kf)) {
-      Map::observe(kf, static_cast<int>(i), p);
-      p->update(scales_);
-    }
-  }
-  kf.updateConnections();
+  // A keyframe whose tracking node inserted it already comes back with its links in place.
+  insertKeyframe(map, kf, scales_, database_);
 }
 
 void LocalMapper::cullRecentPoints(Map& map, const KeyFrame&) {

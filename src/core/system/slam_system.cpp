@@ -1,6 +1,9 @@
 #include "core/system/slam_system.hpp"
 
 #include <chrono>
+#include <thread>
+
+#include "core/mapping/keyframe_insertion.hpp"
 
 namespace hiveslam::core {
 
@@ -28,7 +31,11 @@ SlamSystem::SlamSystem(const SlamSettings& settings, std::shared_ptr<const camer
     tracker_.setPlaceRecognition(vocabulary_.get(), &database_);
     mapper_.setDatabase(&database_);
   }
+  hosting_loop_closing_ = settings_.loop_closing;
   closer_.setActiveMap(&active_map_);
+  closer_.setOnGlobalUpdate([this](const GlobalUpdate& u) {
+    if (events_) events_->globalUpdate(u);
+  });
   if (mode_ != Mode::Sequential) {
     mapping_thread_ = std::thread([this] { mappingLoop(); });
     if (settings_.loop_closing) loop_thread_ = std::thread([this] { loopLoop(); });
@@ -37,6 +44,10 @@ SlamSystem::SlamSystem(const SlamSettings& settings, std::shared_ptr<const camer
 }
 
 void SlamSystem::waitForMapping() {
+  if (!hosting_mapping_ && remote_wait_) {
+    remote_wait_();
+    return;
+  }
   std::unique_lock lock(idle_mutex_);
   idle_cv_.wait(lock, [&] { return jobs_done_ == jobs_pushed_; });
 }
@@ -51,7 +62,68 @@ void SlamSystem::finish() {
 }
 
 void SlamSystem::loopLoop() {
-  while (auto job = loop_jobs_.pop()) closer_.process(job->map, job->keyframe);
+  while (auto job = loop_jobs_.pop()) {
+    closer_.process(job->map, job->keyframe);
+    --loop_jobs_pending_;
+  }
+}
+
+void SlamSystem::setHosting(Hosting hosting) {
+  hosting_mapping_ = hosting.mapping;
+  hosting_loop_closing_ = hosting.loop_closing && settings_.loop_closing;
+}
+
+void SlamSystem::submit(const std::shared_ptr<Map>& map, const std::shared_ptr<KeyFrame>& kf, Module module) {
+  if (module == Module::LoopClosing) {
+    if (!settings_.loop_closing) return;
+    active_map_ = map->resolve();  // the keyframes come from where tracking is
+    if (mode_ == Mode::Sequential) {
+      closer_.process(map, kf);
+    } else {
+      ++loop_jobs_pending_;
+      loop_jobs_.push({map, kf});
+    }
+    return;
+  }
+  if (mode_ == Mode::Sequential) {
+    mapper_.process(map, kf);
+    if (events_) events_->keyframeMapped(map, kf);
+    if (hosting_loop_closing_) closer_.process(map, kf);
+    return;
+  }
+  {
+    std::lock_guard lock(idle_mutex_);
+    ++jobs_pushed_;
+  }
+  jobs_.push({map, kf});
+}
+
+void SlamSystem::addMap(const std::shared_ptr<Map>& map) {
+  std::lock_guard lock(atlas_mutex_);
+  for (const auto& m : maps_)
+    if (m->id == map->id) return;
+  maps_.push_back(map);
+}
+
+std::shared_ptr<Map> SlamSystem::findMap(Id id) const {
+  std::lock_guard lock(atlas_mutex_);
+  for (const auto& m : maps_)
+    if (m->id == id) return m;
+  return nullptr;
+}
+
+std::vector<std::shared_ptr<Map>> SlamSystem::maps() const {
+  std::lock_guard lock(atlas_mutex_);
+  return maps_;
+}
+
+void SlamSystem::drain() {
+  if (mode_ == Mode::Sequential) return;
+  {
+    std::unique_lock lock(idle_mutex_);
+    idle_cv_.wait(lock, [&] { return jobs_done_ == jobs_pushed_; });
+  }
+  while (loop_jobs_pending_ > 0) std::this_thread::sleep_for(std::chrono::milliseconds(5));
 }
 
 void SlamSystem::mappingLoop() {
@@ -64,7 +136,11 @@ void SlamSystem::mappingLoop() {
       ++stale_keyframes_;
     } else {
       mapper_.process(job->map, job->keyframe, &abort_ba_);
-      if (settings_.loop_closing) loop_jobs_.push(*job);
+      if (events_) events_->keyframeMapped(job->map, job->keyframe);
+      if (hosting_loop_closing_) {
+        ++loop_jobs_pending_;
+        loop_jobs_.push(*job);
+      }
     }
     mapping_busy_ = false;
     {
@@ -80,12 +156,15 @@ const FrameRecord& SlamSystem::process(const cv::Mat& gray, double timestamp) {
   FrameRecord r;
   r.index = records_.size();
   r.timestamp = timestamp;
-  const bool idle = mode_ == Mode::Sequential || (!mapping_busy_ && jobs_.size() == 0);
+  const bool remote = !hosting_mapping_;
+  const bool idle = remote ? (!remote_idle_ || remote_idle_())
+                           : mode_ == Mode::Sequential || (!mapping_busy_ && jobs_.size() == 0);
   TrackingOutput out = tracker_.track(makeFrame(gray, r.index, timestamp, extractor_, *camera_), idle);
   r.tracking_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   if (out.new_map) {
-    maps_.push_back(out.new_map);
+    addMap(out.new_map);
     active_map_ = out.new_map.get();
+    if (events_) events_->mapCreated(out.new_map);
   }
   r.inliers = out.inliers;
   r.keyframe = out.new_keyframe != nullptr;
@@ -96,9 +175,16 @@ const FrameRecord& SlamSystem::process(const cv::Mat& gray, double timestamp) {
     r.map = tracker_.map()->id;
   }
   if (out.new_keyframe) {
-    if (mode_ == Mode::Sequential) {
+    if (remote) {
+      {
+        std::lock_guard lock(tracker_.map()->mutex);
+        insertKeyframe(*tracker_.map(), *out.new_keyframe, extractor_.scales(), &database_);
+      }
+      if (events_) events_->keyframeCreated(tracker_.map(), out.new_keyframe);
+    } else if (mode_ == Mode::Sequential) {
       mapper_.process(tracker_.map(), out.new_keyframe);
-      closer_.process(tracker_.map(), out.new_keyframe);
+      if (events_) events_->keyframeMapped(tracker_.map(), out.new_keyframe);
+      if (hosting_loop_closing_) closer_.process(tracker_.map(), out.new_keyframe);
     } else {
       abort_ba_ = true;  // a newer keyframe: the running local BA stops early
       {
@@ -119,7 +205,7 @@ Eigen::Isometry3d SlamSystem::poseOf(const FrameRecord& r) const {
 void SlamSystem::loadAtlas(const std::vector<std::shared_ptr<Map>>& maps, bool localization_only) {
   std::shared_ptr<Map> largest;
   for (const auto& m : maps) {
-    maps_.push_back(m);
+    addMap(m);
     ids_.advancePast(m->id);
     std::lock_guard lock(m->mutex);
     for (const auto& [id, kf] : m->keyframes) {
@@ -136,12 +222,14 @@ void SlamSystem::loadAtlas(const std::vector<std::shared_ptr<Map>>& maps, bool l
 }
 
 Id SlamSystem::currentMapId(Id map) const {
+  std::lock_guard lock(atlas_mutex_);
   for (const auto& m : maps_)
     if (m->id == map) return m->resolve()->id;
   return map;
 }
 
 std::vector<std::shared_ptr<Map>> SlamSystem::liveMaps() const {
+  std::lock_guard lock(atlas_mutex_);
   std::vector<std::shared_ptr<Map>> out;
   for (const auto& m : maps_)
     if (!m->merged_into.load()) out.push_back(m);
@@ -149,6 +237,7 @@ std::vector<std::shared_ptr<Map>> SlamSystem::liveMaps() const {
 }
 
 std::shared_ptr<Map> SlamSystem::largestMap() const {
+  std::lock_guard lock(atlas_mutex_);
   std::shared_ptr<Map> best;
   for (const auto& m : maps_)
     if (!best || m->keyframes.size() > best->keyframes.size()) best = m;

@@ -6,6 +6,7 @@
 // before the next frame, so the same input always gives the same trajectory.
 #include <atomic>
 #include <condition_variable>
+#include <functional>
 #include <mutex>
 #include <memory>
 #include <thread>
@@ -16,6 +17,7 @@
 #include "core/camera/camera_model.hpp"
 #include "core/loop/loop_closer.hpp"
 #include "core/mapping/local_mapper.hpp"
+#include "core/system/system_events.hpp"
 #include "core/tracking/tracker.hpp"
 
 namespace hiveslam::core {
@@ -57,8 +59,32 @@ class SlamSystem {
   // are read after it.
   void finish();
 
+  // The distribution layer's half of the seam (system_events.hpp). Set before the first frame.
+  void setEvents(SystemEvents* events) { events_ = events; }
+  // Which modules run here; the distribution policy changes it when peers come and go. A
+  // keyframe made while mapping is hosted elsewhere goes to SystemEvents::keyframeCreated.
+  void setHosting(Hosting hosting);
+  Hosting hosting() const { return {hosting_mapping_.load(), hosting_loop_closing_.load()}; }
+  // With mapping elsewhere: whether the remote mapper has caught up (keyframe decision), and a
+  // bounded wait for it (offline runs).
+  void setRemoteMapping(std::function<bool()> idle, std::function<void()> wait) {
+    remote_idle_ = std::move(idle);
+    remote_wait_ = std::move(wait);
+  }
+  enum class Module { Mapping, LoopClosing };
+  // A keyframe from another node, already in `map`, for a module of this one.
+  void submit(const std::shared_ptr<Map>& map, const std::shared_ptr<KeyFrame>& kf, Module module);
+  // A map made on another node (or merged here from one); no-op when already known.
+  void addMap(const std::shared_ptr<Map>& map);
+  std::shared_ptr<Map> findMap(Id id) const;
+  KeyframeDatabase& database() { return database_; }
+  const std::vector<double>& scales() const { return extractor_.scales(); }
+  const place::Vocabulary* vocabulary() const { return vocabulary_.get(); }
+  // Blocks until the queued keyframes of the hosted modules are done (end of a run).
+  void drain();
+
   const std::vector<FrameRecord>& frames() const { return records_; }
-  const std::vector<std::shared_ptr<Map>>& maps() const { return maps_; }
+  std::vector<std::shared_ptr<Map>> maps() const;
   int failures() const { return tracker_.failures(); }
   const MappingStats& mappingStats() const { return mapper_.stats(); }
   const LoopStats& loopStats() const { return closer_.stats(); }
@@ -82,8 +108,14 @@ class SlamSystem {
   Tracker tracker_;
   LocalMapper mapper_;
   LoopCloser closer_;
+  mutable std::mutex atlas_mutex_;  // guards maps_ (the distribution layer adds maps)
   std::vector<std::shared_ptr<Map>> maps_;
   std::vector<FrameRecord> records_;
+  SystemEvents* events_ = nullptr;
+  std::atomic<bool> hosting_mapping_{true}, hosting_loop_closing_{true};
+  std::function<bool()> remote_idle_;
+  std::function<void()> remote_wait_;
+  std::atomic<int> loop_jobs_pending_{0};
 
   struct MappingJob {
     std::shared_ptr<Map> map;
@@ -102,8 +134,8 @@ class SlamSystem {
   std::thread mapping_thread_;
   BlockingQueue<MappingJob> loop_jobs_;
   std::thread loop_thread_;
-  std::atomic<int> stale_keyframes_{0};
-  std::atomic<Map*> active_map_{nullptr};  // tracking's map, for the loop closer  // queued for a map that was merged meanwhile
+  std::atomic<int> stale_keyframes_{0};  // queued for a map that was merged meanwhile
+  std::atomic<Map*> active_map_{nullptr};  // tracking's map, for the loop closer
 };
 
 }  // namespace hiveslam::core

@@ -1,0 +1,26 @@
+#pragma once
+// The distributed system on this machine: TR, LM and LC as separate processes (hiveslam node)
+// on a DDS domain of their own, or the standalone system for one node. Behind
+// `hiveslam cluster` and `hiveslam bench`.
+#include <map>
+#include <nlohmann/json.hpp>
+#include <string>
+
+namespace hiveslam::apps {
+
+struct ClusterOptions {
+  int nodes = 3;  // 1: standalone; 2: TR + LM (LM hosts LC); 3: TR + LM + LC
+  std::string dataset, out, config;
+  bool realtime = false;
+  bool no_loop_closing = false;
+  int domain = -1;  // -1: one picked from the process id (concurrent clusters stay apart)
+  int timeout_seconds = 900;
+};
+
+struct ClusterResult {
+  std::map<std::string, nlohmann::json> reports;  // by task: "tr", "lm", "lc"
+};
+
+ClusterResult runCluster(const ClusterOptions& options);
+
+}  // namespace hiveslam::apps

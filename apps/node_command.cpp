@@ -1,0 +1,140 @@
+// hiveslam node --task tr|lm|lc: one node of the distributed system on a DDS domain. TR reads a
+// dataset (what `hiveslam run` reads) and writes what `run` writes; LM and LC serve until the
+// end-of-run exchange completes (or SIGINT/SIGTERM), then write DIR/report.json.
+#include <fmt/format.h>
+
+#include <atomic>
+#include <csignal>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+
+#include "apps/commands.hpp"
+#include "apps/run_slam.hpp"
+#include "common/error.hpp"
+#include "communication/dds/dds_transport.hpp"
+#include "core/system/slam_system.hpp"
+#include "distribution/distributed_node.hpp"
+#include "eval/resource_monitor.hpp"
+#include "io/slam_settings_io.hpp"
+#include "io/vocabulary_file.hpp"
+
+namespace hiveslam::apps {
+
+namespace {
+
+std::atomic<bool> g_stop{false};
+extern "C" void onSignal(int) { g_stop = true; }
+
+struct NodeCommandOptions {
+  std::string task = "tr", name, dataset, out, config, times, expect;
+  int domain = 0, id = 0;
+  bool realtime = false, no_loop_closing = false;
+  int wait_seconds = 20;
+};
+
+uint16_t defaultId(communication::Task t) { return static_cast<uint16_t>(static_cast<int>(t) + 1); }
+
+// LM and LC: a SLAM system without tracking, fed and drained by the distribution layer.
+void serve(const NodeCommandOptions& o, communication::Task task) {
+  eval::ResourceMonitor monitor;
+  core::SlamSettings settings;
+  if (!o.config.empty()) io::applySlamSettings(o.config, settings);
+  if (o.no_loop_closing) settings.loop_closing = false;
+  const auto vocabulary = io::loadVocabulary(settings);
+  const uint16_t id = o.id > 0 ? static_cast<uint16_t>(o.id) : defaultId(task);
+  core::SlamSystem slam(settings, nullptr, core::SlamSystem::Mode::Offline, vocabulary, id);
+  communication::DdsTransport transport({o.domain});
+  distribution::DistributedNode node(slam, transport,
+                                     {task, id, o.name.empty() ? communication::taskName(task) : o.name, {}});
+  std::signal(SIGINT, onSignal);
+  std::signal(SIGTERM, onSignal);
+  node.start();
+  fmt::print(stderr, "node {} ({}) on DDS domain {}: waiting for keyframes\n", id, communication::taskName(task), o.domain);
+  bool done = false;
+  while (!g_stop && !(done = node.waitUntilDone(std::chrono::milliseconds(200)))) {
+  }
+  nlohmann::json report = node.report(monitor.wallSeconds());
+  node.stop();
+  slam.finish();
+  const auto& ms = slam.mappingStats();
+  const auto& ls = slam.loopStats();
+  report["end_of_run"] = done ? "completed" : "interrupted";
+  report["mapping"] = {{"keyframes_processed", ms.keyframes_processed}, {"points_created", ms.points_created},
+                       {"keyframes_culled", ms.keyframes_culled}, {"local_bas", ms.local_bas},
+                       {"local_bas_discarded", ms.local_bas_discarded}};
+  report["loop_closing"] = settings.loop_closing;
+  report["loops"] = ls.loops;
+  report["merges"] = ls.merges;
+  report["global_bas"] = ls.global_bas;
+  size_t kfs = 0;
+  report["map_keyframes"] = nlohmann::json::array();
+  for (const auto& m : slam.liveMaps()) {
+    std::lock_guard lock(m->mutex);
+    kfs += m->keyframes.size();
+    report["map_keyframes"].push_back(m->keyframes.size());
+  }
+  report["keyframes"] = kfs;
+  report["maps"] = report["map_keyframes"].size();
+  report["cpu_seconds"] = monitor.cpuSeconds();
+  report["wall_seconds"] = monitor.wallSeconds();
+  report["cpu_percent"] = monitor.cpuPercent();
+  report["peak_rss_mb"] = eval::ResourceMonitor::peakRssBytes() / 1048576.0;
+  std::filesystem::create_directories(o.out);
+  std::ofstream(std::filesystem::path(o.out) / "report.json") << report.dump(2) << "\n";
+  fmt::print("node {} ({}): {} keyframes mapped, {} loops, {} merges, {:.1f} s CPU, {:.2f} Mbps\n", id,
+             communication::taskName(task), ms.keyframes_processed, ls.loops, ls.merges, monitor.cpuSeconds(),
+             report["bandwidth_mbps"].get<double>());
+}
+
+}  // namespace
+
+void addNodeCommand(CLI::App& app) {
+  auto* cmd = app.add_subcommand("node", "Run one node (tr, lm or lc) of the distributed system over Fast DDS");
+  auto o = std::make_shared<NodeCommandOptions>();
+  cmd->add_option("--task", o->task, "tr (tracking), lm (local mapping) or lc (loop closing)")->required();
+  cmd->add_option("DATASET", o->dataset, "TR's input: what `hiveslam run` reads");
+  cmd->add_option("--out", o->out, "Output folder")->required();
+  cmd->add_option("--domain", o->domain, "DDS domain id (the ROS_DOMAIN_ID)")->capture_default_str();
+  cmd->add_option("--name", o->name, "Node name (default: the task)");
+  cmd->add_option("--id", o->id, "Node id, 1-65535: the high bits of the ids it makes (default: 1 tr, 2 lm, 3 lc)");
+  cmd->add_option("--expect", o->expect, "TR: comma-separated tasks to wait for before the first frame (lm,lc)");
+  cmd->add_option("--wait", o->wait_seconds, "TR: seconds to wait for --expect")->capture_default_str();
+  cmd->add_option("--config", o->config, "Settings YAML");
+  cmd->add_option("--times", o->times, "TR: times file for image folders and videos");
+  cmd->add_flag("--realtime", o->realtime, "TR: feed frames at their timestamps");
+  cmd->add_flag("--no-loop-closing", o->no_loop_closing, "Switch loop closing off");
+  cmd->callback([o]() {
+    communication::Task task;
+    if (!communication::parseTask(o->task, task)) throw InputError("unknown task '" + o->task + "' (tr, lm or lc)");
+    if (o->domain < 0 || o->domain > 232) throw InputError("DDS domain must be 0-232");
+    if (o->id < 0 || o->id > 65535) throw InputError("node id must be 1-65535");
+    if (task != communication::Task::Tracking) {
+      if (!o->dataset.empty()) throw InputError("only a tr node reads a dataset");
+      serve(*o, task);
+      return;
+    }
+    if (o->dataset.empty()) throw InputError("a tr node needs a DATASET");
+    RunOptions run;
+    run.dataset = o->dataset;
+    run.out = o->out;
+    run.config = o->config;
+    run.times = o->times;
+    run.realtime = o->realtime;
+    run.no_loop_closing = o->no_loop_closing;
+    run.network.enabled = true;
+    run.network.domain = o->domain;
+    run.network.id = o->id > 0 ? static_cast<uint16_t>(o->id) : 1;
+    run.network.name = o->name.empty() ? "tr" : o->name;
+    run.network.wait_seconds = o->wait_seconds;
+    std::string rest = o->expect;
+    while (!rest.empty()) {
+      const auto comma = rest.find(',');
+      run.network.expect.push_back(rest.substr(0, comma));
+      rest = comma == std::string::npos ? "" : rest.substr(comma + 1);
+    }
+    fmt::print("{}\n", runSlam(run).line);
+  });
+}
+
+}  // namespace hiveslam::apps

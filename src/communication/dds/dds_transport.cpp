@@ -1,0 +1,357 @@
+#include "communication/dds/dds_transport.hpp"
+
+#include <fastdds/dds/domain/DomainParticipant.hpp>
+#include <fastdds/dds/domain/DomainParticipantFactory.hpp>
+#include <fastdds/dds/domain/DomainParticipantListener.hpp>
+#include <fastdds/dds/publisher/DataWriter.hpp>
+#include <fastdds/dds/publisher/Publisher.hpp>
+#include <fastdds/dds/publisher/qos/DataWriterQos.hpp>
+#include <fastdds/dds/subscriber/DataReader.hpp>
+#include <fastdds/dds/subscriber/DataReaderListener.hpp>
+#include <fastdds/dds/subscriber/SampleInfo.hpp>
+#include <fastdds/dds/subscriber/Subscriber.hpp>
+#include <fastdds/dds/subscriber/qos/DataReaderQos.hpp>
+#include <fastdds/dds/topic/Topic.hpp>
+#include <fastdds/dds/topic/TypeSupport.hpp>
+
+#include <array>
+#include <chrono>
+#include <condition_variable>
+#include <mutex>
+#include <thread>
+#include <unordered_map>
+
+#include "common/blocking_queue.hpp"
+#include "common/error.hpp"
+#include "hiveslam_msgs/msg/NodeInfoPubSubTypes.h"
+#include "hiveslam_msgs/msg/PacketPubSubTypes.h"
+
+namespace hiveslam::communication {
+
+namespace dds = eprosima::fastdds::dds;
+using eprosima::fastrtps::Duration_t;
+using eprosima::fastrtps::rtps::GuidPrefix_t;
+using eprosima::fastrtps::rtps::ParticipantDiscoveryInfo;
+
+namespace {
+
+constexpr const char* kNodeTopic = "rt/hiveslam/nodes";
+
+hiveslam_msgs::msg::NodeInfo toIdl(const PeerInfo& p) {
+  hiveslam_msgs::msg::NodeInfo m;
+  m.version(1);
+  m.node(p.node);
+  m.name(p.name);
+  m.task(static_cast<uint8_t>(p.task));
+  m.hosted(p.hosted);
+  m.incarnation(p.incarnation);
+  m.cores(p.cores);
+  m.load(p.load);
+  m.leaving(p.leaving);
+  return m;
+}
+
+PeerInfo fromIdl(const hiveslam_msgs::msg::NodeInfo& m) {
+  PeerInfo p;
+  p.node = m.node();
+  p.name = m.name();
+  p.task = static_cast<Task>(std::min<uint8_t>(m.task(), 2));
+  p.hosted = m.hosted();
+  p.incarnation = m.incarnation();
+  p.cores = m.cores();
+  p.load = m.load();
+  p.leaving = m.leaving();
+  return p;
+}
+
+}  // namespace
+
+struct DdsTransport::Impl : public dds::DomainParticipantListener {
+  DdsOptions options;
+  dds::DomainParticipant* participant = nullptr;
+  dds::Publisher* publisher = nullptr;
+  dds::Subscriber* subscriber = nullptr;
+  dds::TypeSupport packet_type{new hiveslam_msgs::msg::PacketPubSubType()};
+  dds::TypeSupport node_type{new hiveslam_msgs::msg::NodeInfoPubSubType()};
+  std::array<dds::Topic*, kTopicCount> topics{};
+  dds::Topic* node_topic = nullptr;
+  dds::DataWriter* node_writer = nullptr;
+  dds::DataReader* node_reader = nullptr;
+
+  // Two locks, never held together with a Fast DDS call that may call back: `entities` for
+  // making and deleting writers and readers (listeners never take it), `mutex` for the peer
+  // table and this node's announcement (listeners take it).
+  std::mutex entities;
+  bool closed = true;  // no participant (before start, after stop)
+  std::array<dds::DataWriter*, kTopicCount> writers{};
+  struct Reader;
+  std::array<std::unique_ptr<Reader>, kTopicCount> readers;
+  std::mutex mutex;  // guards everything below
+  PeerInfo self;
+  PeerHandler on_peer;
+  // Which participant each peer announced itself from: a participant lost means that node left.
+  std::unordered_map<uint16_t, std::pair<GuidPrefix_t, PeerInfo>> peers;
+  TrafficCounter counter;
+  bool running = false;
+  std::thread heartbeat;
+  // Peer events go to the handler from their own thread, never from a Fast DDS listener: the
+  // handler subscribes and unsubscribes, which must not happen inside a listener callback.
+  BlockingQueue<std::pair<PeerInfo, bool>> peer_events;
+  std::thread peer_thread;
+  std::condition_variable wake;
+
+  // Delivers a topic's packets to its handler as they arrive (on a Fast DDS thread).
+  struct Reader : public dds::DataReaderListener {
+    Impl* impl = nullptr;
+    Topic topic{};
+    Handler handler;
+    dds::DataReader* reader = nullptr;
+    void on_data_available(dds::DataReader* r) override {
+      hiveslam_msgs::msg::Packet p;
+      dds::SampleInfo info;
+      while (r->take_next_sample(&p, &info) == ReturnCode_t::RETCODE_OK) {
+        if (!info.valid_data) continue;
+        Message m;
+        m.version = p.version();
+        m.source = p.source();
+        m.kind = p.kind();
+        m.target = p.target();
+        m.seq = p.seq();
+        m.map = p.map_id();
+        m.epoch = p.epoch();
+        m.raw_size = p.raw_size();
+        m.body = std::move(p.body());
+        impl->counter.received(topic, m.wireSize());
+        handler(std::move(m));
+      }
+    }
+  };
+
+  // Peer announcements.
+  struct NodeListener : public dds::DataReaderListener {
+    Impl* impl = nullptr;
+    void on_data_available(dds::DataReader* r) override {
+      hiveslam_msgs::msg::NodeInfo m;
+      dds::SampleInfo info;
+      while (r->take_next_sample(&m, &info) == ReturnCode_t::RETCODE_OK) {
+        if (!info.valid_data) continue;
+        const PeerInfo p = fromIdl(m);
+        impl->peerSeen(p, info.sample_identity.writer_guid().guidPrefix);
+      }
+    }
+  } node_listener;
+
+  void peerSeen(const PeerInfo& p, const GuidPrefix_t& prefix) {
+    {
+      std::lock_guard lock(mutex);
+      if (!running || p.node == self.node) return;
+      if (p.leaving) {
+        if (!peers.erase(p.node)) return;
+      } else {
+        auto it = peers.find(p.node);
+        const bool same = it != peers.end() && it->second.second.incarnation == p.incarnation &&
+                          it->second.second.hosted == p.hosted;
+        peers[p.node] = {prefix, p};
+        if (same) return;  // a heartbeat: nothing new
+      }
+    }
+    peer_events.push({p, !p.leaving});
+  }
+
+  void on_participant_discovery(dds::DomainParticipant*, ParticipantDiscoveryInfo&& info) override {
+    if (info.status != ParticipantDiscoveryInfo::REMOVED_PARTICIPANT &&
+        info.status != ParticipantDiscoveryInfo::DROPPED_PARTICIPANT)
+      return;
+    std::lock_guard lock(mutex);
+    for (auto it = peers.begin(); it != peers.end();) {
+      if (it->second.first == info.info.m_guid.guidPrefix) {
+        peer_events.push({it->second.second, false});
+        it = peers.erase(it);
+      } else {
+        ++it;
+      }
+    }
+  }
+
+  dds::DataWriter* writerFor(Topic t) {
+    auto& w = writers[static_cast<size_t>(t)];
+    if (w) return w;
+    dds::DataWriterQos q = dds::DATAWRITER_QOS_DEFAULT;
+    q.reliability().kind = dds::RELIABLE_RELIABILITY_QOS;
+    q.reliability().max_blocking_time = Duration_t(0, 50'000'000);
+    q.history().kind = dds::KEEP_LAST_HISTORY_QOS;  // a dead reader can not stall the writer
+    q.history().depth = options.history_depth;
+    q.durability().kind = dds::VOLATILE_DURABILITY_QOS;
+    q.publish_mode().kind = dds::ASYNCHRONOUS_PUBLISH_MODE;  // large packets are sent off-thread
+    w = publisher->create_datawriter(topics[static_cast<size_t>(t)], q);
+    if (!w) throw InputError(std::string("DDS: cannot create a writer for ") + topicName(t));
+    return w;
+  }
+
+  // Writes happen outside `mutex`: Fast DDS delivers to a reader of the same participant on
+  // the writing thread, and that reader's listener takes `mutex`.
+  void write(const PeerInfo& p) {
+    auto m = toIdl(p);
+    std::lock_guard lock(write_mutex);
+    node_writer->write(&m);
+  }
+  std::mutex write_mutex;
+};
+
+DdsTransport::DdsTransport(DdsOptions options) : impl_(std::make_unique<Impl>()) { impl_->options = options; }
+
+DdsTransport::~DdsTransport() { stop(); }
+
+void DdsTransport::start(const PeerInfo& self, PeerHandler on_peer) {
+  Impl& d = *impl_;
+  dds::DomainParticipantQos pq = dds::PARTICIPANT_QOS_DEFAULT;
+  pq.name(self.name.empty() ? "hiveslam" : self.name);
+  auto& discovery = pq.wire_protocol().builtin.discovery_config;
+  // A dead node is noticed within ~2 s; announcements at start-up come every 100 ms so that
+  // peers match in well under a second (shared/notes: the default can take 3 s).
+  discovery.leaseDuration = Duration_t(2, 0);
+  discovery.leaseDuration_announcementperiod = Duration_t(0, 500'000'000);
+  discovery.initial_announcements.count = 5;
+  discovery.initial_announcements.period = Duration_t(0, 100'000'000);
+  d.participant = dds::DomainParticipantFactory::get_instance()->create_participant(
+      static_cast<dds::DomainId_t>(d.options.domain), pq, &d, dds::StatusMask::none());
+  if (!d.participant) throw InputError("DDS: cannot create a participant on domain " + std::to_string(d.options.domain));
+  d.packet_type.register_type(d.participant);
+  d.node_type.register_type(d.participant);
+  d.publisher = d.participant->create_publisher(dds::PUBLISHER_QOS_DEFAULT);
+  d.subscriber = d.participant->create_subscriber(dds::SUBSCRIBER_QOS_DEFAULT);
+  for (int i = 0; i < kTopicCount; ++i)
+    d.topics[static_cast<size_t>(i)] = d.participant->create_topic(topicName(static_cast<Topic>(i)),
+                                                                   d.packet_type.get_type_name(), dds::TOPIC_QOS_DEFAULT);
+  d.node_topic = d.participant->create_topic(kNodeTopic, d.node_type.get_type_name(), dds::TOPIC_QOS_DEFAULT);
+  dds::DataWriterQos wq = dds::DATAWRITER_QOS_DEFAULT;
+  wq.reliability().kind = dds::RELIABLE_RELIABILITY_QOS;
+  wq.durability().kind = dds::TRANSIENT_LOCAL_DURABILITY_QOS;  // late joiners see who is there
+  wq.history().kind = dds::KEEP_LAST_HISTORY_QOS;
+  wq.history().depth = 1;
+  d.node_writer = d.publisher->create_datawriter(d.node_topic, wq);
+  dds::DataReaderQos rq = dds::DATAREADER_QOS_DEFAULT;
+  rq.reliability().kind = dds::RELIABLE_RELIABILITY_QOS;
+  rq.durability().kind = dds::TRANSIENT_LOCAL_DURABILITY_QOS;
+  rq.history().kind = dds::KEEP_LAST_HISTORY_QOS;
+  rq.history().depth = 8;
+  d.node_listener.impl = &d;
+  {
+    std::lock_guard lock(d.entities);
+    d.closed = false;
+  }
+  {
+    std::lock_guard lock(d.mutex);
+    d.self = self;
+    d.on_peer = std::move(on_peer);
+    d.running = true;
+  }
+  d.peer_thread = std::thread([&d] {
+    while (auto e = d.peer_events.pop())
+      if (d.on_peer) d.on_peer(e->first, e->second);
+  });
+  d.write(self);
+  d.node_reader = d.subscriber->create_datareader(d.node_topic, rq, &d.node_listener);
+  if (!d.node_writer || !d.node_reader) throw InputError("DDS: cannot create the discovery topic");
+  // Announcements repeat once a second: the load changes, and a peer that missed one catches up.
+  d.heartbeat = std::thread([&d] {
+    std::unique_lock lock(d.mutex);
+    while (d.running) {
+      d.wake.wait_for(lock, std::chrono::seconds(1));
+      if (!d.running) break;
+      const PeerInfo p = d.self;
+      lock.unlock();
+      d.write(p);
+      lock.lock();
+    }
+  });
+}
+
+void DdsTransport::announce(const PeerInfo& self) {
+  {
+    std::lock_guard lock(impl_->mutex);
+    impl_->self = self;
+    if (!impl_->running) return;
+  }
+  impl_->write(self);
+}
+
+void DdsTransport::publish(Topic topic, Message&& m) {
+  Impl& d = *impl_;
+  hiveslam_msgs::msg::Packet p;
+  p.version(m.version);
+  p.source(m.source);
+  p.kind(m.kind);
+  p.target(m.target);
+  p.seq(m.seq);
+  p.map_id(m.map);
+  p.epoch(m.epoch);
+  p.raw_size(m.raw_size);
+  const size_t bytes = m.wireSize();
+  p.body(std::move(m.body));
+  // Held through the write: stop() deletes the writers under it.
+  std::lock_guard lock(d.entities);
+  if (d.closed) return;
+  if (d.writerFor(topic)->write(&p)) d.counter.sent(topic, bytes);
+}
+
+void DdsTransport::subscribe(Topic topic, Handler handler) {
+  Impl& d = *impl_;
+  std::lock_guard lock(d.entities);
+  auto& r = d.readers[static_cast<size_t>(topic)];
+  if (r) return;  // one handler per topic for the life of the reader
+  r = std::make_unique<Impl::Reader>();
+  r->impl = &d;
+  r->topic = topic;
+  r->handler = std::move(handler);
+  dds::DataReaderQos q = dds::DATAREADER_QOS_DEFAULT;
+  q.reliability().kind = dds::RELIABLE_RELIABILITY_QOS;
+  q.history().kind = dds::KEEP_LAST_HISTORY_QOS;
+  q.history().depth = d.options.history_depth;
+  r->reader = d.subscriber->create_datareader(d.topics[static_cast<size_t>(topic)], q, r.get());
+  if (!r->reader) throw InputError(std::string("DDS: cannot subscribe to ") + topicName(topic));
+}
+
+void DdsTransport::unsubscribe(Topic topic) {
+  Impl& d = *impl_;
+  std::unique_ptr<Impl::Reader> r;
+  {
+    std::lock_guard lock(d.entities);
+    r = std::move(d.readers[static_cast<size_t>(topic)]);
+  }
+  // Deleting the reader waits for a listener call in progress to return.
+  if (r && r->reader) d.subscriber->delete_datareader(r->reader);
+}
+
+void DdsTransport::stop() {
+  Impl& d = *impl_;
+  PeerInfo last;
+  {
+    std::lock_guard lock(d.mutex);
+    if (!d.running) return;
+    d.self.leaving = true;
+    last = d.self;
+    d.running = false;
+  }
+  d.write(last);  // peers learn at once, not after the lease
+  d.wake.notify_all();
+  if (d.heartbeat.joinable()) d.heartbeat.join();
+  {
+    std::lock_guard lock(d.entities);
+    d.closed = true;
+    // Give the asynchronous writers a moment to flush what is queued (the leaving notice too).
+    for (auto* w : d.writers)
+      if (w) w->wait_for_acknowledgments(Duration_t(0, 500'000'000));
+  }
+  if (d.node_writer) d.node_writer->wait_for_acknowledgments(Duration_t(0, 200'000'000));
+  for (int i = 0; i < kTopicCount; ++i) unsubscribe(static_cast<Topic>(i));
+  d.participant->delete_contained_entities();
+  d.peer_events.close();
+  if (d.peer_thread.joinable()) d.peer_thread.join();
+  dds::DomainParticipantFactory::get_instance()->delete_participant(d.participant);
+  d.participant = nullptr;
+}
+
+TrafficReport DdsTransport::traffic() const { return impl_->counter.report(); }
+
+}  // namespace hiveslam::communication

@@ -1,0 +1,32 @@
+#pragma once
+// Bytes and messages per topic, both ways: every node measures its own traffic.
+#include <array>
+#include <atomic>
+#include <cstdint>
+#include <map>
+#include <string>
+
+#include "communication/message.hpp"
+
+namespace hiveslam::communication {
+
+struct TopicTraffic {
+  uint64_t bytes_out = 0, bytes_in = 0, messages_out = 0, messages_in = 0;
+};
+using TrafficReport = std::map<std::string, TopicTraffic>;  // by topic name, only topics used
+
+class TrafficCounter {
+ public:
+  void sent(Topic t, size_t bytes) { add(t, bytes, 0); }
+  void received(Topic t, size_t bytes) { add(t, bytes, 1); }
+  TrafficReport report() const;
+
+ private:
+  void add(Topic t, size_t bytes, int dir);
+  struct Counts {
+    std::atomic<uint64_t> bytes[2]{0, 0}, messages[2]{0, 0};
+  };
+  std::array<Counts, kTopicCount> counts_;
+};
+
+}  // namespace hiveslam::communication

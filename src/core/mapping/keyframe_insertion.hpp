@@ -1,0 +1,16 @@
+#pragma once
+// Putting a new keyframe into its map: links it to the map points tracking matched, updates
+// their descriptors and viewing ranges, and builds its covisibility. Local mapping does it first
+// thing; a tracking node whose local mapping runs on another node does it itself, so that it
+// can track against its own keyframes before the remote map update arrives. The caller holds
+// the map's mutex.
+#include <vector>
+
+#include "core/map/map.hpp"
+#include "core/place/keyframe_database.hpp"
+
+namespace hiveslam::core {
+
+void insertKeyframe(Map& map, KeyFrame& kf, const std::vector<double>& scales, KeyframeDatabase* database);
+
+}  // namespace hiveslam::core

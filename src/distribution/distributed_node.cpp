@@ -1,0 +1,382 @@
+#include "distribution/distributed_node.hpp"
+
+#include <spdlog/spdlog.h>
+
+#include <chrono>
+
+#include "core/mapping/keyframe_insertion.hpp"
+#include "distribution/packet.hpp"
+
+namespace hiveslam::distribution {
+
+using communication::Message;
+using communication::PeerInfo;
+using communication::Task;
+using communication::Topic;
+using communication::taskBit;
+
+namespace {
+
+constexpr uint8_t kTargetLm = 1, kTargetLc = 2;
+
+Message control(uint16_t source, Control c) {
+  Message m;
+  m.source = source;
+  m.kind = static_cast<uint8_t>(PacketKind::Control);
+  m.target = static_cast<uint8_t>(c);
+  return m;
+}
+
+bool isKeyframeTopic(Topic t) { return t == Topic::TrKeyframes || t == Topic::LmKeyframes; }
+
+}  // namespace
+
+DistributedNode::DistributedNode(core::SlamSystem& slam, communication::Transport& transport, NodeOptions options)
+    : slam_(slam), transport_(transport), options_(std::move(options)), integrator_(slam, observer_) {
+  publisher_ = std::make_unique<KeyframePublisher>(
+      transport_, observer_, ledger_, options_.id, [this](Topic topic, core::Id point) {
+        // TR's receiver (LM) has every point TR received from it; LM's (LC) those sent to it.
+        if (topic == Topic::TrKeyframes) return observer_.hasPoint(point);
+        return ledger_.sent(Topic::LmKeyframes, point) || ledger_.sent(Topic::LmMap, point);
+      });
+  subscriber_ = std::make_unique<KeyframeSubscriber>(
+      integrator_,
+      [this](const StateIntegrator::Added& a, uint8_t target) {
+        if (target == kTargetLc) {
+          {
+            std::lock_guard lock(a.map->mutex);
+            core::insertKeyframe(*a.map, *a.keyframe, slam_.scales(), &slam_.database());
+          }
+          slam_.submit(a.map, a.keyframe, core::SlamSystem::Module::LoopClosing);
+        } else {
+          slam_.submit(a.map, a.keyframe, core::SlamSystem::Module::Mapping);
+        }
+      },
+      [this](const Message& m) { onControl(m, Topic::TrKeyframes); });
+  MapHandler::Hooks hooks;
+  hooks.stale = [this](const MapRecord& m) {
+    std::lock_guard lock(mutex_);
+    auto it = published_.find(m.map);
+    return it != published_.end() && m.epoch < it->second;
+  };
+  hooks.global = [this](std::vector<MapRecord>&& b, Topic t) { onGlobal(std::move(b), t); };
+  hooks.epoch = [this](core::Id map) {
+    std::lock_guard lock(mutex_);
+    auto it = synced_.find(map);
+    return it == synced_.end() ? uint64_t{0} : it->second;
+  };
+  hooks.local_applied = [this](const MapRecord& m) {
+    {
+      std::lock_guard lock(mutex_);
+      for (const auto& k : m.keyframes) outstanding_.erase(k.id);
+    }
+    changed_.notify_all();
+  };
+  hooks.control = [this](const Message& m, Topic t) { onControl(m, t); };
+  handler_ = std::make_unique<MapHandler>(transport_, integrator_, observer_, ledger_, options_.settings, options_.id,
+                                          std::move(hooks));
+  slam_.setEvents(this);
+  slam_.setRemoteMapping([this] { return remoteIdle(); }, [this] { remoteWait(); });
+}
+
+DistributedNode::~DistributedNode() {
+  stop();
+  slam_.setEvents(nullptr);
+}
+
+PeerInfo DistributedNode::self() const {
+  PeerInfo p;
+  p.node = options_.id;
+  p.name = options_.name;
+  p.task = options_.task;
+  p.hosted = plan_.hosted;
+  p.incarnation = incarnation_;
+  p.cores = static_cast<uint16_t>(std::max(1u, std::thread::hardware_concurrency()));
+  return p;
+}
+
+void DistributedNode::start() {
+  incarnation_ = static_cast<uint64_t>(std::chrono::system_clock::now().time_since_epoch().count());
+  {
+    std::lock_guard lock(mutex_);
+    plan_ = decide(options_.task, 0);
+  }
+  slam_.setHosting({plan_.mapping, plan_.loop_closing});
+  transport_.start(self(), [this](const PeerInfo& p, bool present) { onPeer(p, present); });
+  applyPlan();
+}
+
+uint8_t DistributedNode::presentTasks() const {
+  std::lock_guard lock(mutex_);
+  uint8_t present = 0;
+  for (const auto& [id, peer] : peers_) present |= taskBit(peer.task);
+  return present;
+}
+
+Plan DistributedNode::plan() const {
+  std::lock_guard lock(mutex_);
+  return plan_;
+}
+
+void DistributedNode::onPeer(const PeerInfo& peer, bool present) {
+  bool newcomer = false;
+  {
+    std::lock_guard lock(mutex_);
+    if (present) {
+      auto it = peers_.find(peer.node);
+      newcomer = it == peers_.end() || it->second.incarnation != peer.incarnation;
+      peers_[peer.node] = peer;
+    } else {
+      peers_.erase(peer.node);
+    }
+  }
+  spdlog::info("node {}: peer {} ({}) {}", options_.id, peer.name, communication::taskName(peer.task),
+               present ? (newcomer ? "joined" : "changed") : "left");
+  applyPlan();
+  // A node that joins late gets the maps so far from the gateway.
+  if (newcomer && plan().local_maps)
+    for (const auto& map : slam_.liveMaps()) {
+      std::lock_guard lock(mutex_);
+      handler_->sendGlobal(map, synced_[map->id], Topic::LmMap, {}, true);
+    }
+}
+
+void DistributedNode::applyPlan() {
+  std::vector<Topic> add, remove;
+  Plan p;
+  {
+    std::lock_guard lock(mutex_);
+    uint8_t present = 0;
+    for (const auto& [id, peer] : peers_) present |= taskBit(peer.task);
+    p = decide(options_.task, present);
+    const bool changed = p.hosted != plan_.hosted || p.subscriptions != plan_.subscriptions;
+    plan_ = p;
+    for (Topic t : p.subscriptions)
+      if (std::find(subscribed_.begin(), subscribed_.end(), t) == subscribed_.end()) add.push_back(t);
+    for (Topic t : subscribed_)
+      if (std::find(p.subscriptions.begin(), p.subscriptions.end(), t) == p.subscriptions.end()) remove.push_back(t);
+    subscribed_ = p.subscriptions;
+    if (!changed && add.empty() && remove.empty()) return;
+  }
+  slam_.setHosting({p.mapping, p.loop_closing});
+  for (Topic t : remove) transport_.unsubscribe(t);
+  for (Topic t : add) {
+    if (isKeyframeTopic(t))
+      transport_.subscribe(t, [this](Message&& m) { subscriber_->push(std::move(m)); });
+    else
+      transport_.subscribe(t, [this, t](Message&& m) { handler_->incoming(std::move(m), t); });
+  }
+  transport_.announce(self());
+  changed_.notify_all();
+}
+
+void DistributedNode::mapCreated(const std::shared_ptr<core::Map>& map) {
+  std::lock_guard lock(map->mutex);
+  map->journal_on = true;
+}
+
+void DistributedNode::keyframeCreated(const std::shared_ptr<core::Map>& map, const std::shared_ptr<core::KeyFrame>& kf) {
+  if (!plan().keyframes_to_lm) return;
+  {
+    std::lock_guard lock(mutex_);
+    outstanding_.insert(kf->id);
+  }
+  publisher_->push({map, kf, Topic::TrKeyframes, kTargetLm});
+}
+
+void DistributedNode::keyframeMapped(const std::shared_ptr<core::Map>& map, const std::shared_ptr<core::KeyFrame>& kf) {
+  const Plan p = plan();
+  bool anyone = false;
+  {
+    std::lock_guard lock(mutex_);
+    anyone = !peers_.empty();
+  }
+  if (p.local_maps && anyone) handler_->markDirty(map, *kf, Topic::LmMap);
+  if (p.keyframes_to_lc) publisher_->push({map, kf, Topic::LmKeyframes, kTargetLc});
+}
+
+void DistributedNode::globalUpdate(const core::GlobalUpdate& u) {
+  auto map = slam_.findMap(u.map);
+  if (!map) return;
+  std::vector<core::Id> merged;
+  if (u.merged_map != core::kNoId) merged.push_back(u.merged_map);
+  std::lock_guard lock(mutex_);
+  if (options_.task == Task::LoopClosing) {
+    const uint64_t e = std::max(published_[u.map], synced_[u.map]) + 1;
+    published_[u.map] = synced_[u.map] = e;
+    handler_->sendGlobal(map, e, Topic::LcMap, merged);
+  } else if (plan_.local_maps && !peers_.empty()) {
+    const uint64_t e = ++synced_[u.map];
+    handler_->sendGlobal(map, e, Topic::LmMap, merged);
+  }
+}
+
+void DistributedNode::onGlobal(std::vector<MapRecord>&& batches, Topic topic) {
+  const core::Id map_id = batches.front().map;
+  const uint64_t epoch = batches.front().epoch;
+  if (topic == Topic::LcMap) {
+    // The gateway applies LC's update, then relays its own full state of the map: LC's update
+    // plus what LM made meanwhile, in one coordinate frame.
+    integrator_.applyGlobal(batches, false);
+    std::vector<core::Id> merged;
+    for (const auto& b : batches) merged.insert(merged.end(), b.merged_maps.begin(), b.merged_maps.end());
+    auto map = slam_.findMap(map_id);
+    std::lock_guard lock(mutex_);
+    synced_[map_id] = std::max(synced_[map_id], epoch);
+    if (map) handler_->sendGlobal(map, epoch, Topic::LmMap, merged);
+    return;
+  }
+  bool ignore = false;
+  {
+    std::lock_guard lock(mutex_);
+    auto it = published_.find(map_id);
+    // LC takes the relay of its latest update only: an older one would undo a newer correction.
+    if (it != published_.end() && it->second != epoch) {
+      ++globals_ignored_;
+      ignore = true;
+    }
+  }
+  if (ignore) {
+    // Still, what is new here (points LM made) and what LM erased is taken.
+    for (const auto& b : batches) integrator_.applyLocal(b, true);
+    return;
+  }
+  integrator_.applyGlobal(batches, true);
+  std::lock_guard lock(mutex_);
+  synced_[map_id] = std::max(synced_[map_id], epoch);
+}
+
+void DistributedNode::onControl(const Message& m, Topic topic) {
+  const auto c = static_cast<Control>(m.target);
+  if (c == Control::EndOfSequence) {
+    // Runs off the subscriber thread: finishing waits for queues that thread may feed.
+    if (finisher_.joinable()) return;
+    if (options_.task == Task::LoopClosing) {
+      finisher_ = std::thread([this] {
+        slam_.drain();
+        while (!handler_->idle()) std::this_thread::sleep_for(std::chrono::milliseconds(5));
+        transport_.publish(Topic::LcMap, control(options_.id, Control::Done));
+      });
+    } else {
+      finisher_ = std::thread([this] { finishAsGateway(); });
+    }
+    return;
+  }
+  if (c == Control::Done) {
+    {
+      std::lock_guard lock(mutex_);
+      if (topic == Topic::LcMap)
+        lc_done_ = true;
+      else
+        done_ = true;
+    }
+    changed_.notify_all();
+  }
+}
+
+void DistributedNode::finishAsGateway() {
+  slam_.drain();
+  if (plan().keyframes_to_lc) {
+    publisher_->push({nullptr, nullptr, Topic::LmKeyframes, static_cast<uint8_t>(Control::EndOfSequence)});
+    std::unique_lock lock(mutex_);
+    const bool answered = changed_.wait_for(lock, std::chrono::seconds(60), [&] { return lc_done_ || !plan_.keyframes_to_lc; });
+    if (!answered) spdlog::warn("node {}: no Done from LC; sending the last snapshot anyway", options_.id);
+  }
+  while (!handler_->idle()) std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  // The last snapshot: after it, every node holds this node's state.
+  for (const auto& map : slam_.liveMaps()) {
+    std::lock_guard lock(mutex_);
+    handler_->sendGlobal(map, synced_[map->id], Topic::LmMap, {}, true);
+  }
+  while (!handler_->idle()) std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  transport_.publish(Topic::LmMap, control(options_.id, Control::Done));
+  {
+    std::lock_guard lock(mutex_);
+    done_ = true;
+  }
+  changed_.notify_all();
+}
+
+bool DistributedNode::finishRun(std::chrono::milliseconds timeout) {
+  const Plan p = plan();
+  if (p.keyframes_to_lm) {
+    publisher_->push({nullptr, nullptr, Topic::TrKeyframes, static_cast<uint8_t>(Control::EndOfSequence)});
+  } else if (p.local_maps) {
+    finishAsGateway();  // this node maps: it is the gateway
+  } else {
+    slam_.drain();
+    return true;  // alone
+  }
+  return waitUntilDone(timeout);
+}
+
+bool DistributedNode::waitUntilDone(std::chrono::milliseconds timeout) {
+  std::unique_lock lock(mutex_);
+  return changed_.wait_for(lock, timeout, [&] { return done_; });
+}
+
+void DistributedNode::stop() {
+  if (finisher_.joinable()) finisher_.join();
+  publisher_->finish();
+  transport_.stop();
+  subscriber_->finish();
+  handler_->finish();
+}
+
+bool DistributedNode::remoteIdle() const {
+  std::lock_guard lock(mutex_);
+  return outstanding_.empty();
+}
+
+void DistributedNode::remoteWait() const {
+  std::unique_lock lock(mutex_);
+  changed_.wait_for(lock, std::chrono::milliseconds(options_.settings.remote_mapping_wait_ms),
+                    [&] { return outstanding_.empty() || !plan_.keyframes_to_lm; });
+}
+
+nlohmann::json DistributedNode::report(double seconds) const {
+  nlohmann::json j;
+  const Plan p = plan();
+  j["task"] = communication::taskName(options_.task);
+  j["tasks"] = nlohmann::json::array();
+  for (Task t : {Task::Tracking, Task::Mapping, Task::LoopClosing})
+    if (p.hosted & taskBit(t)) j["tasks"].push_back(communication::taskName(t));
+  uint64_t bytes_out = 0, bytes_in = 0, msgs_out = 0, msgs_in = 0, kf_msgs = 0, map_msgs = 0;
+  nlohmann::json topics = nlohmann::json::object();
+  for (const auto& [name, t] : transport_.traffic()) {
+    topics[name] = {{"bytes_out", t.bytes_out}, {"bytes_in", t.bytes_in}, {"messages_out", t.messages_out},
+                    {"messages_in", t.messages_in}};
+    bytes_out += t.bytes_out;
+    bytes_in += t.bytes_in;
+    msgs_out += t.messages_out;
+    msgs_in += t.messages_in;
+    if (name.find("keyframes") != std::string::npos)
+      kf_msgs += t.messages_out + t.messages_in;
+    else
+      map_msgs += t.messages_out + t.messages_in;
+  }
+  const double s = std::max(seconds, 1e-9);
+  j["bytes_out"] = bytes_out;
+  j["bytes_in"] = bytes_in;
+  j["messages_out"] = msgs_out;
+  j["messages_in"] = msgs_in;
+  j["topics"] = topics;
+  j["bandwidth_mbps"] = (bytes_out + bytes_in) * 8.0 / s / 1e6;
+  j["keyframe_msgs_hz"] = kf_msgs / s;
+  j["map_msgs_hz"] = map_msgs / s;
+  j["local_maps_sent"] = handler_->localMapsSent();
+  j["global_maps_sent"] = handler_->globalMapsSent();
+  j["maps_received"] = handler_->mapsReceived();
+  j["keyframes_published"] = publisher_->published();
+  j["keyframes_received"] = subscriber_->received();
+  j["messages_dropped"] = subscriber_->dropped() + handler_->dropped();
+  {
+    std::lock_guard lock(mutex_);
+    j["globals_ignored"] = globals_ignored_;
+    j["peers"] = peers_.size();
+  }
+  j["s_full_keyframes"] = observer_.keyframeCount();
+  return j;
+}
+
+}  // namespace hiveslam::distribution

@@ -1,0 +1,97 @@
+#pragma once
+// One node of the distributed system: this process's SLAM system (core), the distribution
+// layer around it (Observer, KeyFrame Publisher and Subscriber, Map Handler, policy) and a
+// transport. Without a transport, or with no peer, it is the standalone system.
+//
+// End of a run (hiveslam cluster): TR sends EndOfSequence after its last keyframe; LM maps what
+// it has, forwards it to LC; LC finishes its queue and answers Done; LM then sends a last full
+// snapshot of its maps and Done on its map topic. A node is finished when it has that Done:
+// from then on every node's S_full holds the same keyframes and points (eventual consistency).
+#include <atomic>
+#include <condition_variable>
+#include <map>
+#include <set>
+#include <memory>
+#include <mutex>
+#include <nlohmann/json.hpp>
+#include <thread>
+
+#include "communication/transport.hpp"
+#include "core/system/slam_system.hpp"
+#include "distribution/keyframe_publisher.hpp"
+#include "distribution/keyframe_subscriber.hpp"
+#include "distribution/map_handler.hpp"
+#include "distribution/policy.hpp"
+
+namespace hiveslam::distribution {
+
+struct NodeOptions {
+  communication::Task task = communication::Task::Tracking;
+  uint16_t id = 1;
+  std::string name;
+  DistributionSettings settings;
+};
+
+class DistributedNode final : public core::SystemEvents {
+ public:
+  DistributedNode(core::SlamSystem& slam, communication::Transport& transport, NodeOptions options);
+  ~DistributedNode() override;
+
+  // Joins the network and applies the policy to the peers found so far.
+  void start();
+  // TR: after the last frame, runs the end-of-run exchange (bounded by `timeout`). Returns
+  // whether the Done came back.
+  bool finishRun(std::chrono::milliseconds timeout);
+  // LM and LC: blocks until the end-of-run exchange is over (or `timeout`).
+  bool waitUntilDone(std::chrono::milliseconds timeout);
+  // Leaves the network (after the exchange).
+  void stop();
+
+  Plan plan() const;
+  // taskBit()s of the peers present now.
+  uint8_t presentTasks() const;
+  const Observer& observer() const { return observer_; }
+  // What the node adds to `hiveslam run`'s report: tasks, traffic, message rates.
+  nlohmann::json report(double seconds) const;
+
+  // core::SystemEvents
+  void mapCreated(const std::shared_ptr<core::Map>& map) override;
+  void keyframeCreated(const std::shared_ptr<core::Map>& map, const std::shared_ptr<core::KeyFrame>& kf) override;
+  void keyframeMapped(const std::shared_ptr<core::Map>& map, const std::shared_ptr<core::KeyFrame>& kf) override;
+  void globalUpdate(const core::GlobalUpdate& update) override;
+
+ private:
+  void onPeer(const communication::PeerInfo& peer, bool present);
+  void applyPlan();
+  void onGlobal(std::vector<MapRecord>&& batches, communication::Topic topic);
+  void onControl(const communication::Message& m, communication::Topic topic);
+  void finishAsGateway();
+  bool remoteIdle() const;
+  void remoteWait() const;
+  communication::PeerInfo self() const;
+
+  core::SlamSystem& slam_;
+  communication::Transport& transport_;
+  NodeOptions options_;
+  Observer observer_;
+  SentLedger ledger_;
+  StateIntegrator integrator_;
+  std::unique_ptr<KeyframePublisher> publisher_;
+  std::unique_ptr<KeyframeSubscriber> subscriber_;
+  std::unique_ptr<MapHandler> handler_;
+
+  mutable std::mutex mutex_;  // guards everything below
+  mutable std::condition_variable changed_;
+  std::map<uint16_t, communication::PeerInfo> peers_;
+  Plan plan_;
+  std::vector<communication::Topic> subscribed_;
+  std::map<core::Id, uint64_t> synced_;     // last global epoch applied, per map
+  std::map<core::Id, uint64_t> published_;  // LC: last global epoch published, per map
+  std::set<core::Id> outstanding_;          // TR: keyframes sent, not yet in a local map
+  bool done_ = false, lc_done_ = false;
+  int globals_ignored_ = 0;
+  uint64_t incarnation_ = 0;
+  std::thread finisher_;
+};
+
+}  // namespace hiveslam::distribution

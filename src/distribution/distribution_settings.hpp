@@ -1,0 +1,20 @@
+#pragma once
+// The distribution layer's numbers (the paper's, as defaults); the `distribution:` section of
+// a settings file overrides them.
+namespace hiveslam::distribution {
+
+struct DistributionSettings {
+  // Local maps: after each mapped keyframe, the keyframes local BA moved are sent newest first
+  // in batches that grow from first to max keyframes, batch_gap_ms apart.
+  int local_first_batch = 3;
+  int local_max_batch = 15;
+  int local_batch_gap_ms = 50;
+  int local_window = 20;  // covisible keyframes of a mapped keyframe counted as changed
+  // Global maps (loop closure, merge, global BA): the whole map in batches.
+  int global_batch = 10;
+  int global_batch_gap_ms = 100;
+  // Offline runs: how long tracking waits for a remote local map before going on.
+  int remote_mapping_wait_ms = 2000;
+};
+
+}  // namespace hiveslam::distribution

@@ -1,0 +1,72 @@
+#include "distribution/keyframe_publisher.hpp"
+
+#include <spdlog/spdlog.h>
+
+#include "distribution/packet.hpp"
+#include "distribution/state_capture.hpp"
+
+namespace hiveslam::distribution {
+
+KeyframePublisher::KeyframePublisher(communication::Transport& transport, Observer& observer, SentLedger& ledger,
+                                     uint16_t node, Known known)
+    : transport_(transport), observer_(observer), ledger_(ledger), node_(node), known_(std::move(known)) {
+  thread_ = std::thread([this] { loop(); });
+}
+
+KeyframePublisher::~KeyframePublisher() { finish(); }
+
+void KeyframePublisher::finish() {
+  queue_.close();
+  if (thread_.joinable()) thread_.join();
+}
+
+void KeyframePublisher::loop() {
+  while (auto job = queue_.pop()) {
+    try {
+      publish(*job);
+    } catch (const std::exception& e) {
+      spdlog::error("keyframe publisher: {}", e.what());
+    }
+  }
+}
+
+void KeyframePublisher::publish(const Job& job) {
+  if (!job.keyframe) {  // a control packet, in order after the keyframes before it
+    communication::Message c;
+    c.source = node_;
+    c.kind = static_cast<uint8_t>(PacketKind::Control);
+    c.target = job.target;
+    transport_.publish(job.topic, std::move(c));
+    return;
+  }
+  KeyFrameMessage m;
+  uint64_t epoch = 0;
+  {
+    std::lock_guard lock(job.map->mutex);
+    const core::KeyFrame& kf = *job.keyframe;
+    epoch = job.map->epoch;
+    m.keyframe = captureKeyframe(kf, job.map->id, true);
+    std::vector<const core::KeyFrame*> with_points{&kf};
+    // A new map's first keyframe travels with its second (the receiver builds the map from them).
+    if (!maps_started_[job.map->id]) {
+      maps_started_[job.map->id] = true;
+      for (const auto& [id, other] : job.map->keyframes)
+        if (other.get() != &kf && other->id < kf.id) {
+          m.companions.push_back(captureKeyframe(*other, job.map->id, true));
+          with_points.push_back(other.get());
+        }
+    }
+    for (const core::KeyFrame* k : with_points)
+      for (const auto& p : k->points)
+        if (p && !p->bad && !known_(job.topic, p->id)) {
+          m.points.push_back(capturePoint(*p, true));
+          ledger_.mark(job.topic, p->id, static_cast<int>(p->observations.size()));
+        }
+  }
+  observer_.record(m.keyframe);
+  for (const auto& p : m.points) observer_.record(p);
+  transport_.publish(job.topic, pack(m, node_, job.target, job.map->id, epoch));
+  ++published_;
+}
+
+}  // namespace hiveslam::distribution

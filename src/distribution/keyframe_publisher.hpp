@@ -1,0 +1,50 @@
+#pragma once
+// The KeyFrame Publisher: new keyframes out, on its own thread, first in first out. A keyframe
+// is captured under its map's lock only when its turn comes (tracking never waits for the
+// encoding), with full records of the points the receivers do not know yet and, for a new map,
+// the map's first keyframe.
+#include <functional>
+#include <memory>
+#include <thread>
+
+#include "common/blocking_queue.hpp"
+#include "communication/transport.hpp"
+#include "core/map/map.hpp"
+#include "distribution/observer.hpp"
+#include "distribution/sent_ledger.hpp"
+
+namespace hiveslam::distribution {
+
+class KeyframePublisher {
+ public:
+  struct Job {
+    std::shared_ptr<core::Map> map;
+    std::shared_ptr<core::KeyFrame> keyframe;
+    communication::Topic topic = communication::Topic::TrKeyframes;
+    uint8_t target = 0;  // 1 LM, 2 LC; for a control packet (no keyframe) the command
+  };
+  // known(point): the receivers of `topic` already have the point.
+  using Known = std::function<bool(communication::Topic, core::Id)>;
+  KeyframePublisher(communication::Transport& transport, Observer& observer, SentLedger& ledger, uint16_t node,
+                    Known known);
+  ~KeyframePublisher();
+  void push(Job job) { queue_.push(std::move(job)); }
+  // Sends what is queued, then stops the thread.
+  void finish();
+  int published() const { return published_; }
+
+ private:
+  void loop();
+  void publish(const Job& job);
+  communication::Transport& transport_;
+  Observer& observer_;
+  SentLedger& ledger_;
+  uint16_t node_;
+  Known known_;
+  BlockingQueue<Job> queue_;
+  std::atomic<int> published_{0};
+  std::unordered_map<core::Id, bool> maps_started_;  // publisher thread only
+  std::thread thread_;
+};
+
+}  // namespace hiveslam::distribution

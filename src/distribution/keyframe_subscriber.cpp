@@ -1,0 +1,39 @@
+#include "distribution/keyframe_subscriber.hpp"
+
+#include <spdlog/spdlog.h>
+
+#include "distribution/packet.hpp"
+
+namespace hiveslam::distribution {
+
+KeyframeSubscriber::KeyframeSubscriber(StateIntegrator& integrator, Route route, OnControl control)
+    : integrator_(integrator), route_(std::move(route)), control_(std::move(control)) {
+  thread_ = std::thread([this] { loop(); });
+}
+
+KeyframeSubscriber::~KeyframeSubscriber() { finish(); }
+
+void KeyframeSubscriber::finish() {
+  queue_.close();
+  if (thread_.joinable()) thread_.join();
+}
+
+void KeyframeSubscriber::loop() {
+  while (auto m = queue_.pop()) {
+    if (m->kind == static_cast<uint8_t>(PacketKind::Control)) {
+      if (control_) control_(*m);
+      continue;
+    }
+    try {
+      const KeyFrameMessage k = decodeKeyframe(unpack(*m, PacketKind::Keyframe));
+      ++received_;
+      auto added = integrator_.addKeyframe(k);
+      if (added.keyframe) route_(added, m->target);
+    } catch (const std::exception& e) {
+      ++dropped_;
+      spdlog::warn("dropped a keyframe message from node {}: {}", m->source, e.what());
+    }
+  }
+}
+
+}  // namespace hiveslam::distribution

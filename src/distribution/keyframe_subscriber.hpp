@@ -1,0 +1,36 @@
+#pragma once
+// The KeyFrame Subscriber: incoming keyframes, on its own thread, first in first out. Each is
+// decoded, put into its map (StateIntegrator) and handed to the module it targets. A malformed
+// message is logged and dropped.
+#include <functional>
+#include <thread>
+
+#include "common/blocking_queue.hpp"
+#include "communication/message.hpp"
+#include "distribution/state_integrator.hpp"
+
+namespace hiveslam::distribution {
+
+class KeyframeSubscriber {
+ public:
+  using Route = std::function<void(const StateIntegrator::Added&, uint8_t target)>;
+  using OnControl = std::function<void(const communication::Message&)>;
+  KeyframeSubscriber(StateIntegrator& integrator, Route route, OnControl control);
+  ~KeyframeSubscriber();
+  void push(communication::Message&& m) { queue_.push(std::move(m)); }
+  void finish();
+  int received() const { return received_; }
+  int dropped() const { return dropped_; }
+  size_t pending() const { return queue_.size(); }
+
+ private:
+  void loop();
+  StateIntegrator& integrator_;
+  Route route_;
+  OnControl control_;
+  BlockingQueue<communication::Message> queue_;
+  std::atomic<int> received_{0}, dropped_{0};
+  std::thread thread_;
+};
+
+}  // namespace hiveslam::distribution

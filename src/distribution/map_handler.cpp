@@ -1,0 +1,327 @@
+#include "distribution/map_handler.hpp"
+
+#include <spdlog/spdlog.h>
+
+#include <algorithm>
+
+#include "distribution/packet.hpp"
+#include "distribution/state_capture.hpp"
+
+namespace hiveslam::distribution {
+
+using communication::Topic;
+using Clock = std::chrono::steady_clock;
+
+namespace {
+
+size_t linksHash(const KeyFrameRecord& r) {
+  size_t h = std::hash<Id>()(r.parent);
+  for (const auto& [i, p] : r.matches) h = h * 1000003u ^ (std::hash<Id>()(p) + i);
+  for (Id l : r.loop_edges) h = h * 1000003u ^ std::hash<Id>()(l);
+  return h;
+}
+
+}  // namespace
+
+MapHandler::MapHandler(communication::Transport& transport, StateIntegrator& integrator, Observer& observer,
+                       SentLedger& ledger, const DistributionSettings& settings, uint16_t node, Hooks hooks)
+    : transport_(transport),
+      integrator_(integrator),
+      observer_(observer),
+      ledger_(ledger),
+      settings_(settings),
+      node_(node),
+      hooks_(std::move(hooks)) {
+  thread_ = std::thread([this] { loop(); });
+}
+
+MapHandler::~MapHandler() { finish(); }
+
+void MapHandler::finish() {
+  {
+    std::lock_guard lock(mutex_);
+    if (stopping_ && !thread_.joinable()) return;
+    stopping_ = true;
+  }
+  wake_.notify_all();
+  if (thread_.joinable()) thread_.join();
+}
+
+bool MapHandler::idle() const {
+  std::lock_guard lock(mutex_);
+  if (busy_ || !inbox_.empty() || !globals_.empty()) return false;
+  for (const auto& [id, o] : outgoing_)
+    if (!o.dirty.empty() || !o.dirty_points.empty()) return false;
+  return true;
+}
+
+void MapHandler::incoming(communication::Message&& m, Topic topic) {
+  {
+    std::lock_guard lock(mutex_);
+    inbox_.emplace_back(std::move(m), topic);
+  }
+  wake_.notify_all();
+}
+
+void MapHandler::markDirty(const std::shared_ptr<core::Map>& map, const core::KeyFrame& kf, Topic topic) {
+  std::vector<core::Id> kfs, points;
+  {
+    std::lock_guard lock(map->mutex);
+    if (kf.bad) return;
+    std::vector<const core::KeyFrame*> window{&kf};
+    for (const core::KeyFrame* n : kf.bestCovisible(static_cast<size_t>(settings_.local_window))) window.push_back(n);
+    for (const core::KeyFrame* k : window) {
+      kfs.push_back(k->id);
+      for (const auto& p : k->points)
+        if (p && !p->bad) points.push_back(p->id);
+    }
+  }
+  {
+    std::lock_guard lock(mutex_);
+    auto& o = outgoing_[map->id];
+    o.map = map;
+    o.topic = topic;
+    o.dirty.insert(kfs.begin(), kfs.end());
+    o.dirty_points.insert(points.begin(), points.end());
+    o.batch = 0;
+  }
+  wake_.notify_all();
+}
+
+void MapHandler::sendGlobal(const std::shared_ptr<core::Map>& map, uint64_t epoch, Topic topic,
+                            std::vector<core::Id> merged_maps, bool full) {
+  {
+    std::lock_guard lock(mutex_);
+    // A newer global update of the map replaces one not yet (fully) sent.
+    for (auto it = globals_.begin(); it != globals_.end();)
+      if (it->map == map && it->topic == topic && it != globals_.begin())
+        it = globals_.erase(it);
+      else
+        ++it;
+    GlobalJob g;
+    g.map = map;
+    g.epoch = epoch;
+    g.topic = topic;
+    g.merged = std::move(merged_maps);
+    g.full = full;
+    globals_.push_back(std::move(g));
+  }
+  wake_.notify_all();
+}
+
+void MapHandler::loop() {
+  Clock::time_point next_local = Clock::now(), next_global = Clock::now();
+  std::unique_lock lock(mutex_);
+  while (true) {
+    busy_ = false;
+    const auto now = Clock::now();
+    const bool local_pending =
+        std::any_of(outgoing_.begin(), outgoing_.end(), [](const auto& o) { return !o.second.dirty.empty() || !o.second.dirty_points.empty(); });
+    if (!inbox_.empty()) {
+      auto [m, topic] = std::move(inbox_.front());
+      inbox_.pop_front();
+      busy_ = true;
+      lock.unlock();
+      handleIncoming(m, topic);
+      lock.lock();
+      continue;
+    }
+    if (!globals_.empty() && now >= next_global) {
+      GlobalJob g = std::move(globals_.front());
+      globals_.pop_front();
+      busy_ = true;
+      lock.unlock();
+      try {
+        if (g.batches.empty()) captureGlobal(g);
+        if (g.next < g.batches.size()) {
+          MapRecord& b = g.batches[g.next++];
+          trimForSending(b, g.topic, g.full);
+          observer_.record(b);
+          transport_.publish(g.topic, pack(b, node_, 0, b.map, b.epoch));
+          if (g.next == g.batches.size()) ++global_sent_;
+        }
+      } catch (const std::exception& e) {
+        spdlog::error("map handler: {}", e.what());
+        g.next = g.batches.size();
+      }
+      lock.lock();
+      // Unfinished: it goes back to the front unless a newer update of the map came meanwhile.
+      const bool superseded = std::any_of(globals_.begin(), globals_.end(),
+                                          [&](const GlobalJob& o) { return o.map == g.map && o.topic == g.topic; });
+      if (g.next < g.batches.size() && !superseded) globals_.push_front(std::move(g));
+      next_global = Clock::now() + std::chrono::milliseconds(settings_.global_batch_gap_ms);
+      continue;
+    }
+    if (local_pending && now >= next_local) {
+      auto it = std::find_if(outgoing_.begin(), outgoing_.end(), [](const auto& o) { return !o.second.dirty.empty() || !o.second.dirty_points.empty(); });
+      Outgoing& o = it->second;
+      busy_ = true;
+      // The batch's keyframes and points leave the dirty sets under the lock; capture is outside.
+      Outgoing batch;
+      batch.map = o.map;
+      batch.topic = o.topic;
+      const int n = std::min(settings_.local_first_batch * (o.batch + 1), settings_.local_max_batch);
+      while (!o.dirty.empty() && static_cast<int>(batch.dirty.size()) < n) {
+        batch.dirty.insert(*o.dirty.begin());
+        o.dirty.erase(o.dirty.begin());
+      }
+      const bool last = o.dirty.empty();
+      ++o.batch;
+      // Points go with the first batch whose keyframes see them; the rest with the last batch.
+      batch.dirty_points = o.dirty_points;  // filtered during capture
+      lock.unlock();
+      try {
+        sendLocalBatch(batch);
+      } catch (const std::exception& e) {
+        spdlog::error("map handler: {}", e.what());
+      }
+      lock.lock();
+      // batch.dirty_points now holds what was not sent.
+      auto& live = outgoing_[batch.map->id];
+      if (last) {
+        live.dirty_points.clear();
+      } else {
+        for (auto p = live.dirty_points.begin(); p != live.dirty_points.end();)
+          p = batch.dirty_points.count(*p) ? std::next(p) : live.dirty_points.erase(p);
+      }
+      next_local = Clock::now() + std::chrono::milliseconds(settings_.local_batch_gap_ms);
+      continue;
+    }
+    if (stopping_ && inbox_.empty() && globals_.empty() && !local_pending) break;
+    if (local_pending || !globals_.empty())
+      wake_.wait_until(lock, std::min(local_pending ? next_local : Clock::time_point::max(),
+                                      globals_.empty() ? Clock::time_point::max() : next_global));
+    else
+      wake_.wait(lock);
+  }
+}
+
+KeyFrameRecord MapHandler::updateRecord(const core::KeyFrame& kf, core::Id map, Topic topic) {
+  KeyFrameRecord r = captureKeyframe(kf, map, false);
+  const size_t h = linksHash(r);
+  auto& sent = links_sent_[static_cast<size_t>(topic)];
+  auto it = sent.find(kf.id);
+  if (it != sent.end() && it->second == h) {
+    r.links = false;
+    r.matches.clear();
+    r.loop_edges.clear();
+  } else {
+    sent[kf.id] = h;
+  }
+  return r;
+}
+
+void MapHandler::sendLocalBatch(Outgoing& o) {
+  core::Map& map = *o.map;
+  MapRecord m;
+  m.kind = MapRecord::Kind::Local;
+  m.map = map.id;
+  m.epoch = hooks_.epoch ? hooks_.epoch(map.id) : 0;
+  {
+    std::lock_guard lock(map.mutex);
+    if (map.merged_into.load()) {
+      o.dirty_points.clear();
+      return;
+    }
+    m.origin = map.origin ? map.origin->id : kNoId;
+    std::set<core::Id> unsent = o.dirty_points;
+    for (core::Id id : o.dirty) {
+      auto it = map.keyframes.find(id);
+      if (it == map.keyframes.end() || it->second->bad) continue;
+      const core::KeyFrame& kf = *it->second;
+      m.keyframes.push_back(updateRecord(kf, map.id, o.topic));
+      for (const auto& p : kf.points)
+        if (p && !p->bad && unsent.erase(p->id)) m.points.push_back(capturePoint(*p, true));
+    }
+    o.dirty_points = std::move(unsent);
+    m.erased_keyframes = std::move(map.journal.erased_keyframes);
+    m.erased_points = std::move(map.journal.erased_points);
+    m.replaced_points = std::move(map.journal.replaced_points);
+    map.journal = {};
+  }
+  if (m.keyframes.empty() && m.points.empty() && m.erased_keyframes.empty() && m.erased_points.empty() &&
+      m.replaced_points.empty())
+    return;
+  trimForSending(m, o.topic, false);
+  observer_.record(m);
+  transport_.publish(o.topic, pack(m, node_, 0, m.map, m.epoch));
+  ++local_sent_;
+}
+
+void MapHandler::trimForSending(MapRecord& m, Topic topic, bool full) {
+  for (auto& p : m.points) {
+    const bool due = ledger_.needsFull(topic, p.id, p.observations);
+    if (!due && !full) p.full = false;
+  }
+  auto& sent = links_sent_[static_cast<size_t>(topic)];
+  for (const auto& k : m.keyframes)
+    if (k.links) sent[k.id] = linksHash(k);
+}
+
+void MapHandler::captureGlobal(GlobalJob& g) {
+  core::Map& map = *g.map;
+  std::vector<KeyFrameRecord> kfs;
+  std::vector<PointRecord> points;
+  MapRecord base;
+  base.kind = MapRecord::Kind::Global;
+  base.map = map.id;
+  base.epoch = g.epoch;
+  base.merged_maps = g.merged;
+  {
+    std::lock_guard lock(map.mutex);
+    base.origin = map.origin ? map.origin->id : kNoId;
+    std::vector<const core::KeyFrame*> sorted;
+    for (const auto& [id, k] : map.keyframes) sorted.push_back(k.get());
+    std::sort(sorted.begin(), sorted.end(), [](auto* a, auto* b) { return a->id < b->id; });
+    // Links always go with a global map: a receiver may have skipped local maps meanwhile.
+    for (const core::KeyFrame* k : sorted) kfs.push_back(captureKeyframe(*k, map.id, false));
+    for (const auto& [id, p] : map.points)
+      if (!p->bad) points.push_back(capturePoint(*p, true));
+    base.erased_keyframes = std::move(map.journal.erased_keyframes);
+    base.erased_points = std::move(map.journal.erased_points);
+    base.replaced_points = std::move(map.journal.replaced_points);
+    map.journal = {};
+  }
+  std::sort(points.begin(), points.end(), [](const auto& a, const auto& b) { return a.id < b.id; });
+  const size_t per = static_cast<size_t>(std::max(settings_.global_batch, 1));
+  const size_t n = std::max<size_t>(1, (kfs.size() + per - 1) / per);
+  const size_t points_per = (points.size() + n - 1) / n;
+  for (size_t b = 0; b < n; ++b) {
+    MapRecord m = b == 0 ? base : MapRecord{};
+    if (b > 0) {
+      m.kind = base.kind;
+      m.map = base.map;
+      m.epoch = base.epoch;
+      m.origin = base.origin;
+      m.merged_maps = base.merged_maps;
+    }
+    m.batch = static_cast<uint32_t>(b);
+    m.batches = static_cast<uint32_t>(n);
+    for (size_t i = b * per; i < std::min(kfs.size(), (b + 1) * per); ++i) m.keyframes.push_back(std::move(kfs[i]));
+    for (size_t i = b * points_per; i < std::min(points.size(), (b + 1) * points_per); ++i)
+      m.points.push_back(std::move(points[i]));
+    g.batches.push_back(std::move(m));
+  }
+}
+
+void MapHandler::handleIncoming(communication::Message& msg, Topic topic) {
+  if (msg.kind == static_cast<uint8_t>(PacketKind::Control)) {
+    if (hooks_.control) hooks_.control(msg, topic);
+    return;
+  }
+  try {
+    MapRecord m = decodeMap(unpack(msg, PacketKind::Map));
+    ++received_;
+    if (m.kind == MapRecord::Kind::Local) {
+      integrator_.applyLocal(m, hooks_.stale && hooks_.stale(m));
+      if (hooks_.local_applied) hooks_.local_applied(m);
+    } else if (auto all = observer_.collectGlobal(std::move(m))) {
+      if (hooks_.global) hooks_.global(std::move(*all), topic);
+    }
+  } catch (const std::exception& e) {
+    ++dropped_;
+    spdlog::warn("dropped a map message from node {}: {}", msg.source, e.what());
+  }
+}
+
+}  // namespace hiveslam::distribution

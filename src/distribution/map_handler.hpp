@@ -1,0 +1,106 @@
+#pragma once
+// The Map Handler: one thread for incoming and outgoing maps.
+//
+// Outgoing local maps: keyframes that local mapping changed are marked dirty; the handler sends
+// them newest first, with the points they see, in batches that grow while no new keyframe is
+// mapped, each batch a short gap after the last. Keyframe links and point descriptors go only
+// when they changed. Erasures (the map's journal) ride with the next batch.
+// Outgoing global maps: after a loop closure, merge or global BA, the whole map in batches; a
+// newer global update of the same map restarts the sending.
+// Incoming maps: local ones are applied as they come; global ones once all their batches are in.
+#include <condition_variable>
+#include <deque>
+#include <functional>
+#include <memory>
+#include <set>
+#include <thread>
+#include <unordered_map>
+
+#include "communication/transport.hpp"
+#include "distribution/distribution_settings.hpp"
+#include "distribution/sent_ledger.hpp"
+#include "distribution/state_integrator.hpp"
+
+namespace hiveslam::distribution {
+
+class MapHandler {
+ public:
+  struct Hooks {
+    // Incoming local map: whether it predates this node's latest global update of the map.
+    std::function<bool(const MapRecord&)> stale;
+    // Incoming global map, complete (all batches), from `topic`.
+    std::function<void(std::vector<MapRecord>&&, communication::Topic)> global;
+    // Epoch written into outgoing local maps of a map.
+    std::function<uint64_t(core::Id)> epoch;
+    std::function<void(const MapRecord&)> local_applied;
+    // A control packet, in order with the maps of its topic.
+    std::function<void(const communication::Message&, communication::Topic)> control;
+  };
+  MapHandler(communication::Transport& transport, StateIntegrator& integrator, Observer& observer,
+             SentLedger& ledger, const DistributionSettings& settings, uint16_t node, Hooks hooks);
+  ~MapHandler();
+
+  void incoming(communication::Message&& m, communication::Topic topic);
+  // Local mapping finished `kf`: it and its covisible keyframes changed (sent on `topic`).
+  void markDirty(const std::shared_ptr<core::Map>& map, const core::KeyFrame& kf, communication::Topic topic);
+  // The whole map, as a global map of `epoch`, on `topic`.
+  // `full`: every point with its full record and every keyframe with its links (a snapshot for
+  // a node that may have missed updates: a newcomer, or the end of a run).
+  void sendGlobal(const std::shared_ptr<core::Map>& map, uint64_t epoch, communication::Topic topic,
+                  std::vector<core::Id> merged_maps, bool full = false);
+  // Sends everything pending (dirty keyframes, global maps), then stops the thread.
+  void finish();
+  // Whether nothing is waiting to be sent or applied.
+  bool idle() const;
+  int localMapsSent() const { return local_sent_; }
+  int globalMapsSent() const { return global_sent_; }
+  int mapsReceived() const { return received_; }
+  int dropped() const { return dropped_; }
+
+ private:
+  struct Outgoing {
+    std::shared_ptr<core::Map> map;
+    communication::Topic topic{};
+    std::set<core::Id, std::greater<>> dirty;  // keyframe ids, newest first
+    std::set<core::Id> dirty_points;
+    int batch = 0;  // grows while no new keyframe is marked
+  };
+  struct GlobalJob {
+    std::shared_ptr<core::Map> map;
+    uint64_t epoch = 0;
+    communication::Topic topic{};
+    std::vector<core::Id> merged;
+    bool full = false;
+    std::vector<MapRecord> batches;  // captured when its turn comes
+    size_t next = 0;
+  };
+  void loop();
+  void handleIncoming(communication::Message& m, communication::Topic topic);
+  void sendLocalBatch(Outgoing& o);
+  void captureGlobal(GlobalJob& g);
+  KeyFrameRecord updateRecord(const core::KeyFrame& kf, core::Id map, communication::Topic topic);
+  // Just before a batch goes out: point records stripped to positions where the receivers have
+  // the full one, and the ledgers updated with what this batch carries.
+  void trimForSending(MapRecord& m, communication::Topic topic, bool full);
+
+  communication::Transport& transport_;
+  StateIntegrator& integrator_;
+  Observer& observer_;
+  SentLedger& ledger_;
+  DistributionSettings settings_;
+  uint16_t node_;
+  Hooks hooks_;
+
+  mutable std::mutex mutex_;  // guards the queues below
+  std::condition_variable wake_;
+  std::deque<std::pair<communication::Message, communication::Topic>> inbox_;
+  std::unordered_map<core::Id, Outgoing> outgoing_;  // by map
+  std::deque<GlobalJob> globals_;
+  bool stopping_ = false, busy_ = false;
+  std::thread thread_;
+  // Handler thread only: hash of the links last sent per (topic, keyframe).
+  std::unordered_map<core::Id, size_t> links_sent_[communication::kTopicCount];
+  std::atomic<int> local_sent_{0}, global_sent_{0}, received_{0}, dropped_{0};
+};
+
+}  // namespace hiveslam::distribution

@@ -1,0 +1,106 @@
+#include "distribution/observer.hpp"
+
+namespace hiveslam::distribution {
+
+void Observer::record(const KeyFrameRecord& k) {
+  std::lock_guard lock(mutex_);
+  if (erased_keyframes_.count(k.id)) return;
+  auto& stored = keyframes_[k.id];
+  const bool keep_links = !k.links && stored.id == k.id;
+  KeyFrameRecord light = k;
+  light.full = false;
+  light.frame = core::Frame();
+  if (keep_links) {
+    light.links = true;
+    light.parent = stored.parent;
+    light.matches = std::move(stored.matches);
+    light.loop_edges = std::move(stored.loop_edges);
+  }
+  stored = std::move(light);
+}
+
+void Observer::record(const PointRecord& p) {
+  std::lock_guard lock(mutex_);
+  if (erased_points_.count(p.id)) return;
+  auto it = points_.find(p.id);
+  if (it == points_.end() || p.full) {
+    points_[p.id] = p;
+  } else {
+    it->second.position = p.position;
+  }
+}
+
+void Observer::record(const MapRecord& m) {
+  for (const auto& k : m.keyframes) record(k);
+  for (const auto& p : m.points) record(p);
+  for (Id id : m.erased_keyframes) eraseKeyframe(id);
+  for (Id id : m.erased_points) erasePoint(id);
+  for (const auto& [old, by] : m.replaced_points) erasePoint(old);
+}
+
+void Observer::eraseKeyframe(Id id) {
+  std::lock_guard lock(mutex_);
+  keyframes_.erase(id);
+  erased_keyframes_.insert(id);
+}
+
+void Observer::prune(const std::unordered_set<Id>& keyframes, const std::unordered_set<Id>& points,
+                     const std::function<bool(Id)>& known_to_sender) {
+  std::lock_guard lock(mutex_);
+  for (auto it = keyframes_.begin(); it != keyframes_.end();)
+    if (!keyframes.count(it->first) && known_to_sender(it->first)) {
+      erased_keyframes_.insert(it->first);
+      it = keyframes_.erase(it);
+    } else {
+      ++it;
+    }
+  for (auto it = points_.begin(); it != points_.end();)
+    if (!points.count(it->first) && known_to_sender(it->first)) {
+      erased_points_.insert(it->first);
+      it = points_.erase(it);
+    } else {
+      ++it;
+    }
+}
+
+void Observer::erasePoint(Id id) {
+  std::lock_guard lock(mutex_);
+  points_.erase(id);
+  erased_points_.insert(id);
+}
+
+std::optional<std::vector<MapRecord>> Observer::collectGlobal(MapRecord&& batch) {
+  std::lock_guard lock(mutex_);
+  auto& pending = pending_global_[batch.map];
+  if (!pending.empty() && (pending.front().epoch != batch.epoch || pending.front().batches != batch.batches)) {
+    if (pending.front().epoch > batch.epoch) return std::nullopt;  // a late batch of an older update
+    pending.clear();
+  }
+  for (const auto& b : pending)
+    if (b.batch == batch.batch) return std::nullopt;  // duplicate
+  pending.push_back(std::move(batch));
+  if (pending.size() < pending.front().batches) return std::nullopt;
+  std::vector<MapRecord> all = std::move(pending);
+  pending_global_.erase(all.front().map);
+  return all;
+}
+
+bool Observer::hasPoint(Id id) const {
+  std::lock_guard lock(mutex_);
+  return points_.count(id) > 0;
+}
+
+StateDigest Observer::digest() const {
+  std::lock_guard lock(mutex_);
+  StateDigest d;
+  for (const auto& [id, k] : keyframes_) d.keyframes[id] = k.T_cw;
+  for (const auto& [id, p] : points_) d.points[id] = p.position;
+  return d;
+}
+
+size_t Observer::keyframeCount() const {
+  std::lock_guard lock(mutex_);
+  return keyframes_.size();
+}
+
+}  // namespace hiveslam::distribution

@@ -1,0 +1,50 @@
+#pragma once
+// The Observer holds S_full: the latest record of every keyframe and map point this node has
+// published or received (its own SLAM state S_slam lives in the core maps), with erasures
+// applied. It keeps what could not be applied yet (a global map until its last batch) and is
+// what nodes compare to check eventual consistency.
+//
+// Locking: its own mutex, a leaf: taken after a map's mutex or alone, never the other way.
+#include <functional>
+#include <mutex>
+#include <optional>
+#include <unordered_map>
+#include <unordered_set>
+
+#include "distribution/wire/records.hpp"
+
+namespace hiveslam::distribution {
+
+struct StateDigest {
+  std::unordered_map<Id, Eigen::Isometry3d> keyframes;  // T_cw
+  std::unordered_map<Id, Eigen::Vector3d> points;
+};
+
+class Observer {
+ public:
+  void record(const KeyFrameRecord& k);  // frame data is not kept (the core keyframe has it)
+  void record(const PointRecord& p);
+  void record(const MapRecord& m);       // keyframes, points and erasures of one batch
+  void eraseKeyframe(Id id);
+  // After an authoritative snapshot: records it lacks that `known` says it should have had
+  // (the sender erased them) go.
+  void prune(const std::unordered_set<Id>& keyframes, const std::unordered_set<Id>& points,
+             const std::function<bool(Id)>& known_to_sender);
+  void erasePoint(Id id);
+  // A global map's batches until the last one is in; returns all batches then.
+  std::optional<std::vector<MapRecord>> collectGlobal(MapRecord&& batch);
+  bool hasPoint(Id id) const;
+  StateDigest digest() const;
+  size_t keyframeCount() const;
+
+ private:
+  mutable std::mutex mutex_;
+  std::unordered_map<Id, KeyFrameRecord> keyframes_;
+  std::unordered_map<Id, PointRecord> points_;
+  std::unordered_set<Id> erased_keyframes_, erased_points_;
+  // Global map batches being collected, by map, for one epoch at a time (a newer epoch drops
+  // an unfinished older one).
+  std::unordered_map<Id, std::vector<MapRecord>> pending_global_;
+};
+
+}  // namespace hiveslam::distribution

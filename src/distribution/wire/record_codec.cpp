@@ -1,0 +1,258 @@
+#include "distribution/wire/record_codec.hpp"
+
+#include <zstd.h>
+
+#include <cmath>
+
+#include "distribution/wire/byte_codec.hpp"
+
+namespace hiveslam::distribution {
+
+namespace {
+
+void putPose(ByteWriter& w, const Eigen::Isometry3d& T) {
+  const Eigen::Quaterniond q(T.linear());
+  for (double x : {q.w(), q.x(), q.y(), q.z()}) w.put(x);
+  for (int i = 0; i < 3; ++i) w.put(T.translation()[i]);
+}
+
+Eigen::Isometry3d getPose(ByteReader& r) {
+  double c[7];
+  for (double& x : c) x = r.get<double>();
+  Eigen::Quaterniond q(c[0], c[1], c[2], c[3]);
+  if (!std::isfinite(q.norm()) || std::abs(q.norm() - 1.0) > 1e-3) throw WireError("bad rotation");
+  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+  T.linear() = q.normalized().toRotationMatrix();
+  T.translation() = Eigen::Vector3d(c[4], c[5], c[6]);
+  if (!T.translation().allFinite()) throw WireError("bad translation");
+  return T;
+}
+
+void putPoint(ByteWriter& w, const PointRecord& p) {
+  w.put(p.id);
+  for (int i = 0; i < 3; ++i) w.put(static_cast<float>(p.position[i]));
+  w.put(static_cast<uint8_t>(p.full));
+  if (!p.full) return;
+  w.put(p.first_keyframe);
+  w.bytes(p.descriptor.data(), 32);
+  for (int i = 0; i < 3; ++i) w.put(static_cast<float>(p.normal[i]));
+  w.put(static_cast<float>(p.min_distance));
+  w.put(static_cast<float>(p.max_distance));
+}
+
+PointRecord getPoint(ByteReader& r) {
+  PointRecord p;
+  p.id = r.get<Id>();
+  for (int i = 0; i < 3; ++i) p.position[i] = r.get<float>();
+  if (!p.position.allFinite()) throw WireError("bad point position");
+  p.full = r.get<uint8_t>() != 0;
+  if (!p.full) return p;
+  p.first_keyframe = r.get<Id>();
+  r.bytes(p.descriptor.data(), 32);
+  for (int i = 0; i < 3; ++i) p.normal[i] = r.get<float>();
+  p.min_distance = r.get<float>();
+  p.max_distance = r.get<float>();
+  return p;
+}
+
+void putIds(ByteWriter& w, const std::vector<Id>& ids) {
+  w.put(static_cast<uint32_t>(ids.size()));
+  for (Id id : ids) w.put(id);
+}
+
+std::vector<Id> getIds(ByteReader& r) {
+  std::vector<Id> ids(r.count(8));
+  for (Id& id : ids) id = r.get<Id>();
+  return ids;
+}
+
+void putKeyframe(ByteWriter& w, const KeyFrameRecord& k) {
+  w.put(k.id);
+  w.put(k.map);
+  putPose(w, k.T_cw);
+  w.put(static_cast<uint8_t>(k.links || k.full));
+  if (k.links || k.full) {
+    w.put(k.parent);
+    w.put(static_cast<uint32_t>(k.matches.size()));
+    for (const auto& [i, p] : k.matches) {
+      w.put(i);
+      w.put(p);
+    }
+    putIds(w, k.loop_edges);
+  }
+  w.put(static_cast<uint8_t>(k.full));
+  if (!k.full) return;
+  const core::Frame& f = k.frame;
+  w.put(static_cast<uint64_t>(f.index));
+  w.put(f.timestamp);
+  for (double x : {f.K.fx, f.K.fy, f.K.cx, f.K.cy}) w.put(x);
+  w.put(static_cast<int32_t>(f.width));
+  w.put(static_cast<int32_t>(f.height));
+  w.put(k.made_in_epoch);
+  w.put(k.made_from);
+  putPose(w, k.T_made_from);
+  w.put(static_cast<uint32_t>(f.keypoints.size()));
+  // Per keypoint what the core uses after extraction: image position, angle and pyramid level
+  // (matching and scale prediction), the undistorted position (geometry) and the descriptor.
+  for (size_t i = 0; i < f.keypoints.size(); ++i) {
+    const cv::KeyPoint& kp = f.keypoints[i];
+    w.put(kp.pt.x);
+    w.put(kp.pt.y);
+    w.put(kp.angle);
+    w.put(static_cast<uint8_t>(kp.octave));
+    w.put(static_cast<float>(f.points[i].x()));
+    w.put(static_cast<float>(f.points[i].y()));
+    w.bytes(f.descriptors.ptr<uint8_t>(static_cast<int>(i)), 32);
+  }
+}
+
+KeyFrameRecord getKeyframe(ByteReader& r) {
+  KeyFrameRecord k;
+  k.id = r.get<Id>();
+  k.map = r.get<Id>();
+  k.T_cw = getPose(r);
+  k.links = r.get<uint8_t>() != 0;
+  if (k.links) {
+    k.parent = r.get<Id>();
+    k.matches.resize(r.count(12));
+    for (auto& [i, p] : k.matches) {
+      i = r.get<uint32_t>();
+      p = r.get<Id>();
+    }
+    k.loop_edges = getIds(r);
+  }
+  k.full = r.get<uint8_t>() != 0;
+  if (!k.full) return k;
+  core::Frame& f = k.frame;
+  f.index = r.get<uint64_t>();
+  f.timestamp = r.get<double>();
+  f.K.fx = r.get<double>();
+  f.K.fy = r.get<double>();
+  f.K.cx = r.get<double>();
+  f.K.cy = r.get<double>();
+  f.width = r.get<int32_t>();
+  f.height = r.get<int32_t>();
+  if (f.width <= 0 || f.height <= 0 || f.width > 100000 || f.height > 100000) throw WireError("bad image size");
+  k.made_in_epoch = r.get<uint64_t>();
+  k.made_from = r.get<Id>();
+  k.T_made_from = getPose(r);
+  const uint32_t n = r.count(53);
+  f.keypoints.resize(n);
+  f.points.resize(n);
+  f.descriptors = cv::Mat(static_cast<int>(n), 32, CV_8U);
+  for (uint32_t i = 0; i < n; ++i) {
+    cv::KeyPoint& kp = f.keypoints[i];
+    kp.pt.x = r.get<float>();
+    kp.pt.y = r.get<float>();
+    kp.angle = r.get<float>();
+    kp.octave = r.get<uint8_t>();
+    if (kp.octave > 31) throw WireError("bad keypoint level");
+    const float x = r.get<float>(), y = r.get<float>();
+    f.points[i] = Eigen::Vector2d(x, y);
+    r.bytes(f.descriptors.ptr<uint8_t>(static_cast<int>(i)), 32);
+  }
+  for (const auto& [i, p] : k.matches)
+    if (i >= n) throw WireError("match index past the keypoints");
+  f.buildGrid();
+  return k;
+}
+
+}  // namespace
+
+std::vector<uint8_t> encode(const KeyFrameMessage& m) {
+  ByteWriter w;
+  putKeyframe(w, m.keyframe);
+  w.put(static_cast<uint32_t>(m.points.size()));
+  for (const auto& p : m.points) putPoint(w, p);
+  w.put(static_cast<uint32_t>(m.companions.size()));
+  for (const auto& k : m.companions) putKeyframe(w, k);
+  return std::move(w.data());
+}
+
+KeyFrameMessage decodeKeyframe(const std::vector<uint8_t>& raw) {
+  ByteReader r(raw.data(), raw.size());
+  KeyFrameMessage m;
+  m.keyframe = getKeyframe(r);
+  if (!m.keyframe.full) throw WireError("a new keyframe without its features");
+  m.points.resize(r.count(21));
+  for (auto& p : m.points) p = getPoint(r);
+  m.companions.resize(r.count(60));
+  for (auto& k : m.companions) k = getKeyframe(r);
+  if (!r.done()) throw WireError("trailing bytes");
+  return m;
+}
+
+std::vector<uint8_t> encode(const MapRecord& m) {
+  ByteWriter w;
+  w.put(static_cast<uint8_t>(m.kind));
+  w.put(m.map);
+  w.put(m.epoch);
+  w.put(m.batch);
+  w.put(m.batches);
+  w.put(m.origin);
+  w.put(static_cast<uint32_t>(m.keyframes.size()));
+  for (const auto& k : m.keyframes) putKeyframe(w, k);
+  w.put(static_cast<uint32_t>(m.points.size()));
+  for (const auto& p : m.points) putPoint(w, p);
+  putIds(w, m.erased_keyframes);
+  putIds(w, m.erased_points);
+  w.put(static_cast<uint32_t>(m.replaced_points.size()));
+  for (const auto& [a, b] : m.replaced_points) {
+    w.put(a);
+    w.put(b);
+  }
+  putIds(w, m.merged_maps);
+  return std::move(w.data());
+}
+
+MapRecord decodeMap(const std::vector<uint8_t>& raw) {
+  ByteReader r(raw.data(), raw.size());
+  MapRecord m;
+  const auto kind = r.get<uint8_t>();
+  if (kind > 1) throw WireError("unknown map kind");
+  m.kind = static_cast<MapRecord::Kind>(kind);
+  m.map = r.get<Id>();
+  m.epoch = r.get<uint64_t>();
+  m.batch = r.get<uint32_t>();
+  m.batches = r.get<uint32_t>();
+  if (m.batches == 0 || m.batch >= m.batches || m.batches > 100000) throw WireError("bad batch numbers");
+  m.origin = r.get<Id>();
+  m.keyframes.resize(r.count(60));
+  for (auto& k : m.keyframes) k = getKeyframe(r);
+  m.points.resize(r.count(21));
+  for (auto& p : m.points) p = getPoint(r);
+  m.erased_keyframes = getIds(r);
+  m.erased_points = getIds(r);
+  m.replaced_points.resize(r.count(16));
+  for (auto& [a, b] : m.replaced_points) {
+    a = r.get<Id>();
+    b = r.get<Id>();
+  }
+  m.merged_maps = getIds(r);
+  if (!r.done()) throw WireError("trailing bytes");
+  return m;
+}
+
+std::vector<uint8_t> compress(const std::vector<uint8_t>& raw) {
+  std::vector<uint8_t> out(ZSTD_compressBound(raw.size()));
+  // Level 1: most of what zstd can take out of descriptors and floats, at the lowest CPU cost.
+  // The frame checksum (4 bytes) catches a corrupted body before it is decoded.
+  ZSTD_CCtx* ctx = ZSTD_createCCtx();
+  ZSTD_CCtx_setParameter(ctx, ZSTD_c_compressionLevel, 1);
+  ZSTD_CCtx_setParameter(ctx, ZSTD_c_checksumFlag, 1);
+  const size_t n = ZSTD_compress2(ctx, out.data(), out.size(), raw.data(), raw.size());
+  ZSTD_freeCCtx(ctx);
+  if (ZSTD_isError(n)) throw WireError(std::string("zstd: ") + ZSTD_getErrorName(n));
+  out.resize(n);
+  return out;
+}
+
+std::vector<uint8_t> decompress(const std::vector<uint8_t>& packed, uint32_t raw_size) {
+  if (raw_size > (256u << 20)) throw WireError("message too large");
+  std::vector<uint8_t> out(raw_size);
+  const size_t n = ZSTD_decompress(out.data(), out.size(), packed.data(), packed.size());
+  if (ZSTD_isError(n) || n != raw_size) throw WireError("corrupt compressed body");
+  return out;
+}
+
+}  // namespace hiveslam::distribution

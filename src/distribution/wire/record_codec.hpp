@@ -1,0 +1,29 @@
+#pragma once
+// Message bodies: records encoded little-endian (poses in double, point positions and image
+// coordinates in float: sub-micrometre at room scale), then compressed with zstd. Decoding
+// checks every count and index and throws WireError on a malformed body.
+#include <cstdint>
+#include <vector>
+
+#include "distribution/wire/records.hpp"
+
+namespace hiveslam::distribution {
+
+enum class PacketKind : uint8_t { Keyframe = 1, Map = 2, Control = 3 };
+// Control packets (the target field): sent in order with the keyframes or maps of their topic.
+enum class Control : uint8_t {
+  EndOfSequence = 1,  // TR -> LM -> LC: no keyframe after this one
+  Done = 2,           // LC -> LM, then LM -> all: everything is sent; LM's last snapshot precedes it
+};
+constexpr uint16_t kWireVersion = 1;
+
+std::vector<uint8_t> encode(const KeyFrameMessage& m);
+std::vector<uint8_t> encode(const MapRecord& m);
+KeyFrameMessage decodeKeyframe(const std::vector<uint8_t>& raw);
+MapRecord decodeMap(const std::vector<uint8_t>& raw);
+
+std::vector<uint8_t> compress(const std::vector<uint8_t>& raw);
+// raw_size bounds the output (from the packet header, checked against a 256 MB ceiling).
+std::vector<uint8_t> decompress(const std::vector<uint8_t>& packed, uint32_t raw_size);
+
+}  // namespace hiveslam::distribution

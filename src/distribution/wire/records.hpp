@@ -1,0 +1,71 @@
+#pragma once
+// The state that crosses the network, as plain records with ids instead of pointers: what a
+// node publishes about a keyframe or map point, what the Observer stores as S_full, and what
+// the receiving node applies to its SLAM maps. See docs/ARCHITECTURE.md for why each field is
+// sent.
+#include <Eigen/Geometry>
+#include <array>
+#include <vector>
+
+#include "core/frame/frame.hpp"
+#include "core/map/ids.hpp"
+
+namespace hiveslam::distribution {
+
+using core::Id;
+using core::kNoId;
+
+struct PointRecord {
+  Id id = kNoId;
+  Eigen::Vector3d position = Eigen::Vector3d::Zero();
+  // Full records (the first time a point is sent, and when its observations changed) also carry
+  // what matching needs: descriptor, viewing direction and distance range.
+  bool full = false;
+  Id first_keyframe = kNoId;
+  std::array<uint8_t, 32> descriptor{};
+  Eigen::Vector3d normal = Eigen::Vector3d::Zero();
+  double min_distance = 0, max_distance = 0;
+  int observations = 0;  // not sent: lets a sender tell when the full record is due again
+};
+
+struct KeyFrameRecord {
+  Id id = kNoId;
+  Id map = kNoId;
+  Eigen::Isometry3d T_cw = Eigen::Isometry3d::Identity();
+  // Links (parent, point matches, loop edges) are left out of an update when unchanged since
+  // the last one on the same topic: they are most of a keyframe update's bytes.
+  bool links = true;
+  Id parent = kNoId;
+  std::vector<std::pair<uint32_t, Id>> matches;  // keypoint index -> map point
+  std::vector<Id> loop_edges;
+  // A new keyframe (full) carries its image features and where tracking posed it.
+  bool full = false;
+  core::Frame frame;
+  uint64_t made_in_epoch = 0;
+  Id made_from = kNoId;
+  Eigen::Isometry3d T_made_from = Eigen::Isometry3d::Identity();
+};
+
+// A batch of a local map (after local BA) or of a global map (after loop closure, merge or
+// global BA). A global map is complete only with all its batches: it is applied at once.
+struct MapRecord {
+  enum class Kind : uint8_t { Local = 0, Global = 1 } kind = Kind::Local;
+  Id map = kNoId;
+  uint64_t epoch = 0;
+  uint32_t batch = 0, batches = 1;
+  Id origin = kNoId;
+  std::vector<KeyFrameRecord> keyframes;
+  std::vector<PointRecord> points;
+  std::vector<Id> erased_keyframes, erased_points;
+  std::vector<std::pair<Id, Id>> replaced_points;  // (old, by)
+  std::vector<Id> merged_maps;                     // maps now living in `map`
+};
+
+// A new keyframe with the points it sees that the receiver may not know yet.
+struct KeyFrameMessage {
+  KeyFrameRecord keyframe;
+  std::vector<PointRecord> points;
+  std::vector<KeyFrameRecord> companions;  // a new map's first keyframe travels with its second
+};
+
+}  // namespace hiveslam::distribution

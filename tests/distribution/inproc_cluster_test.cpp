@@ -1,0 +1,122 @@
+// Three nodes (TR, LM, LC) in one process on the in-process network: the rendered loop is
+// tracked at TR with mapping and loop closing offloaded, the loop is closed at LC, and after the
+// end-of-run exchange every node's S_full (and SLAM map) holds the same keyframes and points
+// with poses equal to within 1 mm.
+#include <gtest/gtest.h>
+
+#include "communication/inproc/inproc_network.hpp"
+#include "core/camera/pinhole_radtan.hpp"
+#include "core/system/slam_system.hpp"
+#include "distribution/distributed_node.hpp"
+#include "eval/trajectory_error.hpp"
+#include "synth/sequence.hpp"
+
+namespace hiveslam::distribution {
+namespace {
+
+using communication::Task;
+
+std::shared_ptr<const place::Vocabulary> shippedVocabulary() {
+  static const auto voc = std::make_shared<const place::Vocabulary>(
+      place::Vocabulary::load(std::string(HIVESLAM_SOURCE_DIR) + "/data/vocabulary/orb_k10_l4.bin"));
+  return voc;
+}
+
+void expectSameState(const StateDigest& a, const StateDigest& b, const char* what) {
+  EXPECT_EQ(a.keyframes.size(), b.keyframes.size()) << what;
+  EXPECT_EQ(a.points.size(), b.points.size()) << what;
+  int missing = 0;
+  double worst = 0;
+  for (const auto& [id, T] : a.keyframes) {
+    auto it = b.keyframes.find(id);
+    if (it == b.keyframes.end()) {
+      ++missing;
+      continue;
+    }
+    worst = std::max(worst, (T.inverse().translation() - it->second.inverse().translation()).norm());
+  }
+  for (const auto& [id, p] : a.points) {
+    auto it = b.points.find(id);
+    if (it == b.points.end()) {
+      ++missing;
+      continue;
+    }
+    worst = std::max(worst, (p - it->second).norm());
+  }
+  EXPECT_EQ(missing, 0) << what;
+  EXPECT_LT(worst, 1e-3) << what;
+}
+
+StateDigest slamState(const core::SlamSystem& slam) {
+  StateDigest d;
+  for (const auto& map : slam.liveMaps()) {
+    std::lock_guard lock(map->mutex);
+    for (const auto& [id, k] : map->keyframes) d.keyframes[id] = k->T_cw;
+    for (const auto& [id, p] : map->points) d.points[id] = p->position;
+  }
+  return d;
+}
+
+TEST(InProcCluster, ThreeNodesTrackCloseTheLoopAndAgree) {
+  synth::SequenceOptions o;
+  o.trajectory = "loop";
+  o.frames = 500;
+  o.seed = 1;
+  const auto model = synth::buildSequence(o);
+  const synth::RayTable rays(model.lens);
+  auto camera = std::make_shared<camera::PinholeRadTan>(model.lens.width, model.lens.height, model.lens.fx,
+                                                              model.lens.fy, model.lens.cx, model.lens.cy);
+  const auto voc = shippedVocabulary();
+  using Mode = core::SlamSystem::Mode;
+  core::SlamSystem tr(core::SlamSettings{}, camera, Mode::Offline, voc, 1);
+  core::SlamSystem lm(core::SlamSettings{}, camera, Mode::Offline, voc, 2);
+  core::SlamSystem lc(core::SlamSettings{}, camera, Mode::Offline, voc, 3);
+  communication::InProcNetwork network;
+  auto e_tr = network.endpoint(), e_lm = network.endpoint(), e_lc = network.endpoint();
+  DistributedNode n_lm(lm, *e_lm, {Task::Mapping, 2, "lm", {}});
+  DistributedNode n_lc(lc, *e_lc, {Task::LoopClosing, 3, "lc", {}});
+  DistributedNode n_tr(tr, *e_tr, {Task::Tracking, 1, "tr", {}});
+  n_lm.start();
+  n_lc.start();
+  n_tr.start();
+  EXPECT_FALSE(n_tr.plan().mapping);
+  EXPECT_FALSE(n_tr.plan().loop_closing);
+  EXPECT_FALSE(n_lm.plan().loop_closing);
+
+  io::Trajectory truth;
+  for (int f = 0; f < o.frames; ++f) {
+    tr.process(model.renderImage(f, rays), model.stamp(f));
+    truth.add(model.stamp(f), model.pose(f));
+  }
+  ASSERT_TRUE(n_tr.finishRun(std::chrono::seconds(120)));
+  ASSERT_TRUE(n_lm.waitUntilDone(std::chrono::seconds(30)));
+  ASSERT_TRUE(n_lc.waitUntilDone(std::chrono::seconds(30)));
+
+  int tracked = 0;
+  io::Trajectory estimate;
+  const auto map = tr.largestMap();
+  for (const auto& r : tr.frames()) {
+    if (!r.tracked) continue;
+    ++tracked;
+    if (tr.currentMapId(r.map) == map->id) estimate.add(r.timestamp, tr.poseOf(r));
+  }
+  EXPECT_GT(tracked, o.frames * 9 / 10);
+  const auto ate = eval::computeAte(truth, estimate);
+  EXPECT_LT(ate.stats.rmse / ate.reference_length, 0.01);
+  EXPECT_GE(lc.loopStats().loops, 1);
+  EXPECT_EQ(tr.mappingStats().keyframes_processed, 0);  // TR mapped nothing itself
+
+  expectSameState(n_lm.observer().digest(), n_tr.observer().digest(), "S_full LM vs TR");
+  expectSameState(n_lm.observer().digest(), n_lc.observer().digest(), "S_full LM vs LC");
+  expectSameState(slamState(lm), slamState(tr), "S_slam LM vs TR");
+  expectSameState(slamState(lm), slamState(lc), "S_slam LM vs LC");
+  n_tr.stop();
+  n_lm.stop();
+  n_lc.stop();
+  tr.finish();
+  lm.finish();
+  lc.finish();
+}
+
+}  // namespace
+}  // namespace hiveslam::distribution
