@@ -24,6 +24,7 @@ int main(int argc, char** argv) {
   hiveslam::apps::addVocabCommand(app);
   hiveslam::apps::addNodeCommand(app);
   hiveslam::apps::addClusterCommand(app);
+  hiveslam::apps::addBenchCommand(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

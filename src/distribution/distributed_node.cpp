@@ -249,6 +249,10 @@ void DistributedNode::onGlobal(std::vector<MapRecord>&& batches, Topic topic) {
 void DistributedNode::onControl(const Message& m, Topic topic) {
   const auto c = static_cast<Control>(m.target);
   if (c == Control::EndOfSequence) {
+    {
+      std::lock_guard lock(mutex_);
+      run_hosted_ = plan_.hosted;
+    }
     // Runs off the subscriber thread: finishing waits for queues that thread may feed.
     if (finisher_.joinable()) return;
     if (options_.task == Task::LoopClosing) {
@@ -299,6 +303,10 @@ void DistributedNode::finishAsGateway() {
 
 bool DistributedNode::finishRun(std::chrono::milliseconds timeout) {
   const Plan p = plan();
+  {
+    std::lock_guard lock(mutex_);
+    run_hosted_ = p.hosted;
+  }
   if (p.keyframes_to_lm) {
     publisher_->push({nullptr, nullptr, Topic::TrKeyframes, static_cast<uint8_t>(Control::EndOfSequence)});
   } else if (p.local_maps) {
@@ -336,11 +344,15 @@ void DistributedNode::remoteWait() const {
 
 nlohmann::json DistributedNode::report(double seconds) const {
   nlohmann::json j;
-  const Plan p = plan();
+  uint8_t hosted = 0;
+  {
+    std::lock_guard lock(mutex_);
+    hosted = run_hosted_ ? run_hosted_ : plan_.hosted;
+  }
   j["task"] = communication::taskName(options_.task);
   j["tasks"] = nlohmann::json::array();
   for (Task t : {Task::Tracking, Task::Mapping, Task::LoopClosing})
-    if (p.hosted & taskBit(t)) j["tasks"].push_back(communication::taskName(t));
+    if (hosted & taskBit(t)) j["tasks"].push_back(communication::taskName(t));
   uint64_t bytes_out = 0, bytes_in = 0, msgs_out = 0, msgs_in = 0, kf_msgs = 0, map_msgs = 0;
   nlohmann::json topics = nlohmann::json::object();
   for (const auto& [name, t] : transport_.traffic()) {

@@ -10,6 +10,9 @@ struct DistributionSettings {
   int local_max_batch = 15;
   int local_batch_gap_ms = 50;
   int local_window = 20;  // covisible keyframes of a mapped keyframe counted as changed
+  // A point's position goes out again in a local map only when it moved more than this (map
+  // units: the first two keyframes set the scale, median depth 1). Global maps send all.
+  double min_point_move = 1e-4;
   // Global maps (loop closure, merge, global BA): the whole map in batches.
   int global_batch = 10;
   int global_batch_gap_ms = 100;

@@ -2,6 +2,8 @@
 
 #include <spdlog/spdlog.h>
 
+#include <set>
+
 #include "distribution/packet.hpp"
 #include "distribution/state_capture.hpp"
 
@@ -62,6 +64,21 @@ void KeyframePublisher::publish(const Job& job) {
           m.points.push_back(capturePoint(*p, true));
           ledger_.mark(job.topic, p->id, static_cast<int>(p->observations.size()));
         }
+    // Tracking's counts for points made since the last few keyframes (local mapping's
+    // candidates for culling), found among the keyframe's neighbours.
+    auto& recent = recent_[job.map->id];
+    if (job.topic == communication::Topic::TrKeyframes && !recent.empty()) {
+      const core::Id since = recent.front();
+      std::set<core::MapPoint*, core::ById> seen;
+      std::vector<const core::KeyFrame*> around{&kf};
+      for (const core::KeyFrame* n : kf.bestCovisible(10)) around.push_back(n);
+      for (const core::KeyFrame* k : around)
+        for (const auto& p : k->points)
+          if (p && !p->bad && p->first_keyframe >= since && seen.insert(p.get()).second)
+            m.stats.push_back({p->id, static_cast<uint32_t>(p->visible), static_cast<uint32_t>(p->found)});
+    }
+    recent.push_back(kf.id);
+    if (recent.size() > 4) recent.pop_front();
   }
   observer_.record(m.keyframe);
   for (const auto& p : m.points) observer_.record(p);

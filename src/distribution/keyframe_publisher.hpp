@@ -3,6 +3,7 @@
 // is captured under its map's lock only when its turn comes (tracking never waits for the
 // encoding), with full records of the points the receivers do not know yet and, for a new map,
 // the map's first keyframe.
+#include <deque>
 #include <functional>
 #include <memory>
 #include <thread>
@@ -44,6 +45,7 @@ class KeyframePublisher {
   BlockingQueue<Job> queue_;
   std::atomic<int> published_{0};
   std::unordered_map<core::Id, bool> maps_started_;  // publisher thread only
+  std::unordered_map<core::Id, std::deque<core::Id>> recent_;  // last keyframes sent, per map
   std::thread thread_;
 };
 

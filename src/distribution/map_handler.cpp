@@ -249,10 +249,21 @@ void MapHandler::sendLocalBatch(Outgoing& o) {
 }
 
 void MapHandler::trimForSending(MapRecord& m, Topic topic, bool full) {
+  std::vector<PointRecord> kept;
+  kept.reserve(m.points.size());
   for (auto& p : m.points) {
     const bool due = ledger_.needsFull(topic, p.id, p.observations);
-    if (!due && !full) p.full = false;
+    const bool moved = ledger_.moved(topic, p.id, p.position, settings_.min_point_move);
+    if (!due && !full) {
+      // A position update only when it moved: local BA leaves most of a window's points where
+      // they were to well under a tenth of a millimetre.
+      if (!moved && m.kind == MapRecord::Kind::Local) continue;
+      p.full = false;
+    }
+    kept.push_back(std::move(p));
   }
+  std::sort(kept.begin(), kept.end(), [](const auto& a, const auto& b) { return a.id < b.id; });
+  m.points = std::move(kept);
   auto& sent = links_sent_[static_cast<size_t>(topic)];
   for (const auto& k : m.keyframes)
     if (k.links) sent[k.id] = linksHash(k);

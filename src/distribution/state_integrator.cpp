@@ -149,6 +149,11 @@ StateIntegrator::Added StateIntegrator::addKeyframe(const KeyFrameMessage& m) {
       if (auto it = map->points.find(pid); it != map->points.end() && i < kf->points.size()) kf->points[i] = it->second;
     if (!map->origin) map->origin = kf.get();
     for (auto& c : companions) c->updateConnections();
+    for (const auto& s : m.stats)
+      if (auto it = map->points.find(s.id); it != map->points.end()) {
+        it->second->visible = std::max(it->second->visible, static_cast<int>(s.visible));
+        it->second->found = std::max(it->second->found, static_cast<int>(s.found));
+      }
   }
   for (const auto& p : m.points) observer_.record(p);
   for (const auto& c : m.companions) observer_.record(c);

@@ -26,6 +26,19 @@ class ByteWriter {
     const auto* b = static_cast<const uint8_t*>(p);
     out_.insert(out_.end(), b, b + n);
   }
+  // LEB128: ids written as differences from the previous one take one or two bytes.
+  void varint(uint64_t v) {
+    while (v >= 0x80) {
+      out_.push_back(static_cast<uint8_t>(v | 0x80));
+      v >>= 7;
+    }
+    out_.push_back(static_cast<uint8_t>(v));
+  }
+  void delta(uint64_t v, uint64_t& previous) {
+    const auto d = static_cast<int64_t>(v - previous);
+    varint((static_cast<uint64_t>(d) << 1) ^ static_cast<uint64_t>(d >> 63));  // zigzag
+    previous = v;
+  }
   std::vector<uint8_t>& data() { return out_; }
 
  private:
@@ -47,6 +60,21 @@ class ByteReader {
     need(n);
     std::memcpy(out, p_, n);
     p_ += n;
+  }
+  uint64_t varint() {
+    uint64_t v = 0;
+    for (int shift = 0; shift < 64; shift += 7) {
+      const auto b = get<uint8_t>();
+      v |= static_cast<uint64_t>(b & 0x7f) << shift;
+      if (!(b & 0x80)) return v;
+    }
+    throw WireError("bad varint");
+  }
+  uint64_t delta(uint64_t& previous) {
+    const uint64_t z = varint();
+    const auto d = static_cast<int64_t>((z >> 1) ^ (~(z & 1) + 1));
+    previous += static_cast<uint64_t>(d);
+    return previous;
   }
   // A count followed by items of at least `item_bytes` each: checked against what is left.
   uint32_t count(size_t item_bytes) {

@@ -2,6 +2,7 @@
 
 #include <zstd.h>
 
+#include <algorithm>
 #include <cmath>
 
 #include "distribution/wire/byte_codec.hpp"
@@ -28,8 +29,8 @@ Eigen::Isometry3d getPose(ByteReader& r) {
   return T;
 }
 
-void putPoint(ByteWriter& w, const PointRecord& p) {
-  w.put(p.id);
+void putPoint(ByteWriter& w, const PointRecord& p, uint64_t& previous_id) {
+  w.delta(p.id, previous_id);
   for (int i = 0; i < 3; ++i) w.put(static_cast<float>(p.position[i]));
   w.put(static_cast<uint8_t>(p.full));
   if (!p.full) return;
@@ -40,9 +41,9 @@ void putPoint(ByteWriter& w, const PointRecord& p) {
   w.put(static_cast<float>(p.max_distance));
 }
 
-PointRecord getPoint(ByteReader& r) {
+PointRecord getPoint(ByteReader& r, uint64_t& previous_id) {
   PointRecord p;
-  p.id = r.get<Id>();
+  p.id = r.delta(previous_id);
   for (int i = 0; i < 3; ++i) p.position[i] = r.get<float>();
   if (!p.position.allFinite()) throw WireError("bad point position");
   p.full = r.get<uint8_t>() != 0;
@@ -74,9 +75,10 @@ void putKeyframe(ByteWriter& w, const KeyFrameRecord& k) {
   if (k.links || k.full) {
     w.put(k.parent);
     w.put(static_cast<uint32_t>(k.matches.size()));
+    uint64_t previous_index = 0, previous_id = 0;
     for (const auto& [i, p] : k.matches) {
-      w.put(i);
-      w.put(p);
+      w.delta(i, previous_index);
+      w.delta(p, previous_id);
     }
     putIds(w, k.loop_edges);
   }
@@ -114,10 +116,13 @@ KeyFrameRecord getKeyframe(ByteReader& r) {
   k.links = r.get<uint8_t>() != 0;
   if (k.links) {
     k.parent = r.get<Id>();
-    k.matches.resize(r.count(12));
+    k.matches.resize(r.count(2));
+    uint64_t previous_index = 0, previous_id = 0;
     for (auto& [i, p] : k.matches) {
-      i = r.get<uint32_t>();
-      p = r.get<Id>();
+      const uint64_t index = r.delta(previous_index);
+      if (index > 0xffffffffu) throw WireError("bad keypoint index");
+      i = static_cast<uint32_t>(index);
+      p = r.delta(previous_id);
     }
     k.loop_edges = getIds(r);
   }
@@ -163,9 +168,17 @@ std::vector<uint8_t> encode(const KeyFrameMessage& m) {
   ByteWriter w;
   putKeyframe(w, m.keyframe);
   w.put(static_cast<uint32_t>(m.points.size()));
-  for (const auto& p : m.points) putPoint(w, p);
+  uint64_t previous = 0;
+  for (const auto& p : m.points) putPoint(w, p, previous);
   w.put(static_cast<uint32_t>(m.companions.size()));
   for (const auto& k : m.companions) putKeyframe(w, k);
+  w.put(static_cast<uint32_t>(m.stats.size()));
+  uint64_t previous_id = 0;
+  for (const auto& s : m.stats) {
+    w.delta(s.id, previous_id);
+    w.varint(s.visible);
+    w.varint(s.found);
+  }
   return std::move(w.data());
 }
 
@@ -174,10 +187,18 @@ KeyFrameMessage decodeKeyframe(const std::vector<uint8_t>& raw) {
   KeyFrameMessage m;
   m.keyframe = getKeyframe(r);
   if (!m.keyframe.full) throw WireError("a new keyframe without its features");
-  m.points.resize(r.count(21));
-  for (auto& p : m.points) p = getPoint(r);
-  m.companions.resize(r.count(60));
+  m.points.resize(r.count(14));
+  uint64_t previous = 0;
+  for (auto& p : m.points) p = getPoint(r, previous);
+  m.companions.resize(r.count(57));
   for (auto& k : m.companions) k = getKeyframe(r);
+  m.stats.resize(r.count(3));
+  uint64_t previous_id = 0;
+  for (auto& s : m.stats) {
+    s.id = r.delta(previous_id);
+    s.visible = static_cast<uint32_t>(std::min<uint64_t>(r.varint(), 0xffffffffu));
+    s.found = static_cast<uint32_t>(std::min<uint64_t>(r.varint(), 0xffffffffu));
+  }
   if (!r.done()) throw WireError("trailing bytes");
   return m;
 }
@@ -193,7 +214,8 @@ std::vector<uint8_t> encode(const MapRecord& m) {
   w.put(static_cast<uint32_t>(m.keyframes.size()));
   for (const auto& k : m.keyframes) putKeyframe(w, k);
   w.put(static_cast<uint32_t>(m.points.size()));
-  for (const auto& p : m.points) putPoint(w, p);
+  uint64_t previous = 0;
+  for (const auto& p : m.points) putPoint(w, p, previous);
   putIds(w, m.erased_keyframes);
   putIds(w, m.erased_points);
   w.put(static_cast<uint32_t>(m.replaced_points.size()));
@@ -217,10 +239,11 @@ MapRecord decodeMap(const std::vector<uint8_t>& raw) {
   m.batches = r.get<uint32_t>();
   if (m.batches == 0 || m.batch >= m.batches || m.batches > 100000) throw WireError("bad batch numbers");
   m.origin = r.get<Id>();
-  m.keyframes.resize(r.count(60));
+  m.keyframes.resize(r.count(57));
   for (auto& k : m.keyframes) k = getKeyframe(r);
-  m.points.resize(r.count(21));
-  for (auto& p : m.points) p = getPoint(r);
+  m.points.resize(r.count(14));
+  uint64_t previous = 0;
+  for (auto& p : m.points) p = getPoint(r, previous);
   m.erased_keyframes = getIds(r);
   m.erased_points = getIds(r);
   m.replaced_points.resize(r.count(16));

@@ -62,10 +62,18 @@ struct MapRecord {
 };
 
 // A new keyframe with the points it sees that the receiver may not know yet.
+struct PointStats {
+  Id id = kNoId;
+  uint32_t visible = 0, found = 0;  // times tracking predicted it in view / matched it
+};
+
 struct KeyFrameMessage {
   KeyFrameRecord keyframe;
   std::vector<PointRecord> points;
   std::vector<KeyFrameRecord> companions;  // a new map's first keyframe travels with its second
+  // Tracking's counts for the points local mapping made recently: its culling of weak new
+  // points (found / visible below a quarter) needs them, and only tracking sees them.
+  std::vector<PointStats> stats;
 };
 
 }  // namespace hiveslam::distribution

@@ -1,0 +1,28 @@
+#pragma once
+// The paper's benchmark protocol (hiveslam bench), also behind the demo.
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+namespace hiveslam::apps {
+
+struct BenchOptions {
+  std::vector<std::string> sequences;
+  std::string out, config;
+  int repeats = 1;
+  std::vector<int> nodes{1, 3};
+  bool realtime = true;
+};
+
+struct BenchRow {
+  std::string sequence;
+  int nodes = 1;
+  std::vector<double> ate, ate_percent, fails, tracked, cpu_seconds, cpu_percent, bw_tr, bw_lm, bw_lc, kf_hz, map_hz,
+      loops;
+  nlohmann::json toJson() const;
+};
+
+nlohmann::json runBench(const BenchOptions& options);
+std::string benchTable(const nlohmann::json& rows);
+
+}  // namespace hiveslam::apps

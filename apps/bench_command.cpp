@@ -1,0 +1,116 @@
+// hiveslam bench SEQUENCE... --out DIR: the paper's protocol. Every sequence in the 1-node and
+// the 3-node configuration (or those given), N repeats each, frames fed at their timestamps;
+// prints the paper's table rows (ATE, fails, CPU at TR, bandwidth TR/LM/LC, keyframe and map
+// message rates) and writes DIR/bench.json.
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <filesystem>
+#include <fstream>
+
+#include "apps/bench.hpp"
+#include "apps/cluster.hpp"
+#include "apps/commands.hpp"
+#include "common/error.hpp"
+
+namespace hiveslam::apps {
+
+namespace {
+
+double median(std::vector<double> v) {
+  if (v.empty()) return 0;
+  std::sort(v.begin(), v.end());
+  const size_t n = v.size();
+  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+double maxOf(const std::vector<double>& v) { return v.empty() ? 0 : *std::max_element(v.begin(), v.end()); }
+
+double mbps(const nlohmann::json& j) { return j.is_object() ? j.value("bandwidth_mbps", 0.0) : 0.0; }
+
+}  // namespace
+
+nlohmann::json runBench(const BenchOptions& o) {
+  nlohmann::json all = nlohmann::json::array();
+  const std::filesystem::path out(o.out);
+  for (const auto& seq : o.sequences) {
+    const std::string name = std::filesystem::path(seq).filename().string();
+    for (int nodes : o.nodes) {
+      BenchRow row;
+      row.sequence = name;
+      row.nodes = nodes;
+      for (int r = 0; r < o.repeats; ++r) {
+        ClusterOptions c;
+        c.nodes = nodes;
+        c.dataset = seq;
+        c.out = (out / name / fmt::format("{}node_run{}", nodes, r + 1)).string();
+        c.realtime = o.realtime;
+        c.config = o.config;
+        fmt::print(stderr, "bench: {} {}-node run {}/{}\n", name, nodes, r + 1, o.repeats);
+        const auto result = runCluster(c);
+        const auto& tr = result.reports.at("tr");
+        row.ate.push_back(tr.contains("ate") ? tr["ate"]["rmse"].get<double>() : -1);
+        row.ate_percent.push_back(tr.contains("ate") ? tr["ate"]["percent_of_path"].get<double>() : -1);
+        row.fails.push_back(tr.value("failures", 0));
+        row.tracked.push_back(100.0 * tr.value("tracked_frames", 0) / std::max(tr.value("frames", 1), 1));
+        row.cpu_seconds.push_back(tr.value("cpu_seconds", 0.0));
+        row.cpu_percent.push_back(tr.value("cpu_percent", 0.0));
+        row.bw_tr.push_back(mbps(tr));
+        row.bw_lm.push_back(result.reports.count("lm") ? mbps(result.reports.at("lm")) : 0);
+        row.bw_lc.push_back(result.reports.count("lc") ? mbps(result.reports.at("lc")) : 0);
+        row.kf_hz.push_back(tr.value("keyframe_msgs_hz", 0.0));
+        row.map_hz.push_back(tr.value("map_msgs_hz", 0.0));
+        row.loops.push_back(result.reports.count("lc") ? result.reports.at("lc").value("loops", 0)
+                            : result.reports.count("lm") ? result.reports.at("lm").value("loops", 0)
+                                                         : tr.value("loops", 0));
+      }
+      all.push_back(row.toJson());
+    }
+  }
+  std::filesystem::create_directories(out);
+  std::ofstream(out / "bench.json") << all.dump(2) << "\n";
+  return all;
+}
+
+std::string benchTable(const nlohmann::json& rows) {
+  std::string t = fmt::format("{:<12} {:>5} {:>16} {:>8} {:>6} {:>9} {:>7} {:>7} {:>16} {:>11} {:>5}\n", "sequence",
+                              "nodes", "ATE m (med/max)", "ATE %", "fails", "TR CPU s", "TR CPU%", "tracked",
+                              "BW TR/LM/LC", "KF/Map Hz", "loops");
+  for (const auto& r : rows) {
+    auto m = [&](const char* k) { return r[k]["median"].get<double>(); };
+    t += fmt::format("{:<12} {:>5} {:>7.4f}/{:<8.4f} {:>8.3f} {:>6.1f} {:>9.1f} {:>7.1f} {:>6.1f}% {:>5.1f}/{:>4.1f}/{:>4.1f} {:>5.1f}/{:<5.1f} {:>5.1f}\n",
+                     r["sequence"].get<std::string>(), r["nodes"].get<int>(), m("ate"), r["ate"]["max"].get<double>(),
+                     m("ate_percent"), m("fails"), m("cpu_seconds"), m("cpu_percent"), m("tracked"), m("bw_tr"),
+                     m("bw_lm"), m("bw_lc"), m("kf_hz"), m("map_hz"), m("loops"));
+  }
+  t += "medians over the runs; BW in Mbps (both directions) at each node; rates of the keyframe and map messages at TR\n";
+  return t;
+}
+
+nlohmann::json BenchRow::toJson() const {
+  auto stat = [](const std::vector<double>& v) {
+    return nlohmann::json{{"median", median(v)}, {"max", maxOf(v)}, {"runs", v}};
+  };
+  return {{"sequence", sequence}, {"nodes", nodes},        {"ate", stat(ate)},
+          {"ate_percent", stat(ate_percent)}, {"fails", stat(fails)}, {"tracked", stat(tracked)},
+          {"cpu_seconds", stat(cpu_seconds)}, {"cpu_percent", stat(cpu_percent)}, {"bw_tr", stat(bw_tr)},
+          {"bw_lm", stat(bw_lm)}, {"bw_lc", stat(bw_lc)}, {"kf_hz", stat(kf_hz)}, {"map_hz", stat(map_hz)},
+          {"loops", stat(loops)}};
+}
+
+void addBenchCommand(CLI::App& app) {
+  auto* cmd = app.add_subcommand("bench", "The paper's protocol: 1-node and 3-node runs, N repeats, a table");
+  auto o = std::make_shared<BenchOptions>();
+  cmd->add_option("SEQUENCES", o->sequences, "Datasets (what `hiveslam run` reads)")->required();
+  cmd->add_option("--out", o->out, "Output folder")->required();
+  cmd->add_option("--repeats", o->repeats, "Runs per sequence and configuration")->capture_default_str();
+  cmd->add_option("--nodes", o->nodes, "Configurations (node counts)")->delimiter(',')->capture_default_str();
+  cmd->add_option("--config", o->config, "Settings YAML");
+  cmd->add_flag("!--offline", o->realtime, "Frames as fast as mapping allows instead of at their timestamps");
+  cmd->callback([o]() {
+    if (o->repeats < 1) throw InputError("--repeats must be at least 1");
+    fmt::print("{}", benchTable(runBench(*o)));
+  });
+}
+
+}  // namespace hiveslam::apps

@@ -1,0 +1,119 @@
+// The node program as separate processes over Fast DDS: on loopback (hiveslam cluster), and in
+// three network namespaces joined by a bridge, each node with its own network stack as on
+// separate devices (root only; skipped with a message where namespaces cannot be made).
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <cstdlib>
+#include <fstream>
+#include <nlohmann/json.hpp>
+
+#include "synth/sequence.hpp"
+#include "temp_dir.hpp"
+
+namespace hiveslam {
+namespace {
+
+namespace fs = std::filesystem;
+
+// A short rendered loop, made once for the tests of this file.
+const fs::path& sequence() {
+  static testing::TempDir dir;
+  static const fs::path seq = [] {
+    synth::SequenceOptions o;
+    o.trajectory = "loop";
+    o.frames = 240;
+    o.seed = 5;
+    synth::writeSequence(o, dir / "loop", nullptr);
+    return dir / "loop";
+  }();
+  return seq;
+}
+
+nlohmann::json report(const fs::path& file) {
+  std::ifstream in(file);
+  EXPECT_TRUE(in.good()) << file;
+  return in ? nlohmann::json::parse(in) : nlohmann::json::object();
+}
+
+std::vector<std::string> tasks(const nlohmann::json& r) { return r.value("tasks", std::vector<std::string>{}); }
+
+TEST(NodeProcesses, ThreeNodesOverLoopback) {
+  testing::TempDir out;
+  const std::string cmd = std::string(HIVESLAM_BINARY) + " cluster --nodes 3 " + sequence().string() + " --out " +
+                          out.path().string() + " > " + (out / "log").string() + " 2>&1";
+  ASSERT_EQ(std::system(cmd.c_str()), 0) << std::ifstream(out / "log").rdbuf();
+  EXPECT_TRUE(fs::exists(out / "trajectory.tum"));
+  const auto tr = report(out / "tr" / "report.json"), lm = report(out / "lm" / "report.json"),
+             lc = report(out / "lc" / "report.json");
+  EXPECT_EQ(tasks(tr), std::vector<std::string>{"tr"});
+  EXPECT_EQ(tasks(lm), std::vector<std::string>{"lm"});
+  EXPECT_EQ(tasks(lc), std::vector<std::string>{"lc"});
+  EXPECT_GT(tr.value("tracked_frames", 0), 200);
+  EXPECT_LT(tr["ate"]["percent_of_path"].get<double>(), 1.0);
+  EXPECT_GT(tr.value("bytes_out", 0), 0);
+  EXPECT_GT(tr.value("bytes_in", 0), 0);
+  EXPECT_EQ(tr.value("keyframes_published", 0), lm.value("keyframes_received", -1));
+  EXPECT_EQ(lm["mapping"]["keyframes_processed"], tr.value("keyframes_published", -1));
+  EXPECT_EQ(lm.value("end_of_run", ""), "completed");
+  EXPECT_EQ(lc.value("end_of_run", ""), "completed");
+  EXPECT_EQ(tr.value("messages_dropped", -1), 0);
+  // The same keyframes in S_full everywhere after the end-of-run exchange.
+  EXPECT_EQ(tr.value("s_full_keyframes", 0), lm.value("s_full_keyframes", -1));
+  EXPECT_EQ(lc.value("s_full_keyframes", 0), lm.value("s_full_keyframes", -1));
+}
+
+TEST(NodeProcesses, OneNodeIsTheStandaloneSystem) {
+  testing::TempDir out;
+  const std::string cmd = std::string(HIVESLAM_BINARY) + " cluster --nodes 1 " + sequence().string() + " --out " +
+                          out.path().string() + " > " + (out / "log").string() + " 2>&1";
+  ASSERT_EQ(std::system(cmd.c_str()), 0) << std::ifstream(out / "log").rdbuf();
+  const auto tr = report(out / "tr" / "report.json");
+  EXPECT_FALSE(tr.contains("topics"));  // no transport was made: no participant, no socket
+  EXPECT_FALSE(fs::exists(out / "lm"));
+  EXPECT_GT(tr.value("tracked_frames", 0), 200);
+}
+
+TEST(NodeProcesses, ThreeNodesInThreeNetworkNamespaces) {
+  if (geteuid() != 0) GTEST_SKIP() << "network namespaces need root";
+  const std::string tag = std::to_string(getpid() % 100000);
+  const std::string br = "hsbr" + tag;
+  auto ns = [&](int i) { return "hs" + tag + "n" + std::to_string(i); };
+  std::string setup = "set -e; ip link add " + br + " type bridge; ip link set " + br + " up;";
+  for (int i = 1; i <= 3; ++i) {
+    const std::string v = "hv" + tag + std::to_string(i);
+    setup += "ip netns add " + ns(i) + "; ip link add " + v + " type veth peer name " + v + "p; ip link set " + v +
+             "p master " + br + "; ip link set " + v + "p up; ip link set " + v + " netns " + ns(i) + ";" +
+             "ip netns exec " + ns(i) + " ip addr add 10.213." + std::to_string(getpid() % 200) + "." +
+             std::to_string(i) + "/24 dev " + v + "; ip netns exec " + ns(i) + " ip link set " + v +
+             " up; ip netns exec " + ns(i) + " ip link set lo up; ip netns exec " + ns(i) +
+             " ip route add 224.0.0.0/4 dev " + v + ";";
+  }
+  std::string teardown;
+  for (int i = 1; i <= 3; ++i) teardown += "ip netns del " + ns(i) + " 2>/dev/null;";
+  teardown += "ip link del " + br + " 2>/dev/null; true";
+  if (std::system(("(" + setup + ") > /dev/null 2>&1").c_str()) != 0) {
+    std::system(teardown.c_str());
+    GTEST_SKIP() << "cannot make network namespaces here (ip netns / veth / bridge failed)";
+  }
+  testing::TempDir out;
+  const std::string bin = HIVESLAM_BINARY, domain = " --domain 7 ";
+  auto node = [&](int i, const std::string& args) {
+    return "ip netns exec " + ns(i) + " " + bin + " node" + domain + args + " > " + (out / ("log" + std::to_string(i))).string() + " 2>&1";
+  };
+  const std::string run = node(2, "--task lm --out " + (out / "lm").string()) + " & " +
+                          node(3, "--task lc --out " + (out / "lc").string()) + " & " +
+                          node(1, "--task tr " + sequence().string() + " --expect lm,lc --out " + (out / "tr").string()) +
+                          "; status=$?; wait; exit $status";
+  const int status = std::system(("timeout 600 bash -c '" + run + "'").c_str());
+  std::system(teardown.c_str());
+  ASSERT_EQ(status, 0) << std::ifstream(out / "log1").rdbuf();
+  const auto tr = report(out / "tr" / "report.json"), lm = report(out / "lm" / "report.json");
+  EXPECT_EQ(tasks(tr), std::vector<std::string>{"tr"});
+  EXPECT_GT(tr.value("tracked_frames", 0), 200);
+  EXPECT_EQ(lm.value("end_of_run", ""), "completed");
+  EXPECT_EQ(tr.value("s_full_keyframes", 0), lm.value("s_full_keyframes", -1));
+}
+
+}  // namespace
+}  // namespace hiveslam
