@@ -19,14 +19,6 @@ namespace {
 
 constexpr uint8_t kTargetLm = 1, kTargetLc = 2;
 
-Message control(uint16_t source, Control c) {
-  Message m;
-  m.source = source;
-  m.kind = static_cast<uint8_t>(PacketKind::Control);
-  m.target = static_cast<uint8_t>(c);
-  return m;
-}
-
 bool isKeyframeTopic(Topic t) { return t == Topic::TrKeyframes || t == Topic::LmKeyframes; }
 
 }  // namespace
@@ -259,7 +251,7 @@ void DistributedNode::onControl(const Message& m, Topic topic) {
       finisher_ = std::thread([this] {
         slam_.drain();
         while (!handler_->idle()) std::this_thread::sleep_for(std::chrono::milliseconds(5));
-        transport_.publish(Topic::LcMap, control(options_.id, Control::Done));
+        transport_.publish(Topic::LcMap, controlPacket(options_.id, Control::Done));
       });
     } else {
       finisher_ = std::thread([this] { finishAsGateway(); });
@@ -293,7 +285,7 @@ void DistributedNode::finishAsGateway() {
     handler_->sendGlobal(map, synced_[map->id], Topic::LmMap, {}, true);
   }
   while (!handler_->idle()) std::this_thread::sleep_for(std::chrono::milliseconds(5));
-  transport_.publish(Topic::LmMap, control(options_.id, Control::Done));
+  transport_.publish(Topic::LmMap, controlPacket(options_.id, Control::Done));
   {
     std::lock_guard lock(mutex_);
     done_ = true;

@@ -34,11 +34,7 @@ void KeyframePublisher::loop() {
 
 void KeyframePublisher::publish(const Job& job) {
   if (!job.keyframe) {  // a control packet, in order after the keyframes before it
-    communication::Message c;
-    c.source = node_;
-    c.kind = static_cast<uint8_t>(PacketKind::Control);
-    c.target = job.target;
-    transport_.publish(job.topic, std::move(c));
+    transport_.publish(job.topic, controlPacket(node_, static_cast<Control>(job.target)));
     return;
   }
   KeyFrameMessage m;

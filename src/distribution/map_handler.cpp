@@ -298,13 +298,16 @@ void MapHandler::captureGlobal(GlobalJob& g) {
   const size_t n = std::max<size_t>(1, (kfs.size() + per - 1) / per);
   const size_t points_per = (points.size() + n - 1) / n;
   for (size_t b = 0; b < n; ++b) {
-    MapRecord m = b == 0 ? base : MapRecord{};
-    if (b > 0) {
-      m.kind = base.kind;
-      m.map = base.map;
-      m.epoch = base.epoch;
-      m.origin = base.origin;
-      m.merged_maps = base.merged_maps;
+    MapRecord m;
+    m.kind = base.kind;
+    m.map = base.map;
+    m.epoch = base.epoch;
+    m.origin = base.origin;
+    m.merged_maps = base.merged_maps;
+    if (b == 0) {  // erasures once
+      m.erased_keyframes = std::move(base.erased_keyframes);
+      m.erased_points = std::move(base.erased_points);
+      m.replaced_points = std::move(base.replaced_points);
     }
     m.batch = static_cast<uint32_t>(b);
     m.batches = static_cast<uint32_t>(n);

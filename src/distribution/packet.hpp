@@ -21,6 +21,15 @@ communication::Message pack(const Record& record, uint16_t source, uint8_t targe
   return m;
 }
 
+// A control packet: header only, the command in the target field.
+inline communication::Message controlPacket(uint16_t source, Control command) {
+  communication::Message m;
+  m.source = source;
+  m.kind = static_cast<uint8_t>(PacketKind::Control);
+  m.target = static_cast<uint8_t>(command);
+  return m;
+}
+
 inline std::vector<uint8_t> unpack(const communication::Message& m, PacketKind expected) {
   if (m.version != kWireVersion) throw WireError("wire version " + std::to_string(m.version) + " not supported");
   if (m.kind != static_cast<uint8_t>(expected)) throw WireError("unexpected packet kind");

@@ -203,14 +203,7 @@ void StateIntegrator::applyGlobal(const std::vector<MapRecord>& batches, bool au
       auto other = slam_.findMap(merged);
       if (!other || other == map || other->merged_into.load()) continue;
       std::scoped_lock both(map->mutex, other->mutex);
-      for (auto& [id, k] : other->keyframes) map->keyframes[id] = k;
-      for (auto& [id, p] : other->points) map->points[id] = p;
-      map->retired.insert(map->retired.end(), other->retired.begin(), other->retired.end());
-      other->keyframes.clear();
-      other->points.clear();
-      other->retired.clear();
-      ++other->epoch;
-      other->merged_into = map.get();
+      map->absorb(*other);
       slam_.database().moveMap(other.get(), map.get());
     }
   std::lock_guard lock(map->mutex);

@@ -475,16 +475,7 @@ void LoopCloser::mergeMaps(Map& map, KeyFrame& kf, Map& other, const Verified& v
   const Sim3 S_ba = S_ab.inverse();
   for (const auto& [id, k] : other.keyframes) k->T_cw = (Sim3(k->T_cw) * S_ba).toPose();
   for (const auto& [id, p] : other.points) p->position = S_ab * p->position;
-  for (auto& [id, k] : other.keyframes) map.keyframes[id] = k;
-  for (auto& [id, p] : other.points) map.points[id] = p;
-  map.retired.insert(map.retired.end(), other.retired.begin(), other.retired.end());
-  map.erased_points.insert(map.erased_points.end(), other.erased_points.begin(), other.erased_points.end());
-  other.keyframes.clear();
-  other.points.clear();
-  other.retired.clear();
-  other.erased_points.clear();
-  ++other.epoch;
-  other.merged_into = &map;
+  map.absorb(other);
   database_.moveMap(&other, &map);
   for (const auto& p : v.place_points)
     if (!p->bad) p->update(scales_);

@@ -38,6 +38,19 @@ void Map::replace(MapPoint& old, const std::shared_ptr<MapPoint>& by) {
   }
 }
 
+void Map::absorb(Map& other) {
+  for (auto& [id, k] : other.keyframes) keyframes[id] = k;
+  for (auto& [id, p] : other.points) points[id] = p;
+  retired.insert(retired.end(), other.retired.begin(), other.retired.end());
+  erased_points.insert(erased_points.end(), other.erased_points.begin(), other.erased_points.end());
+  other.keyframes.clear();
+  other.points.clear();
+  other.retired.clear();
+  other.erased_points.clear();
+  ++other.epoch;
+  other.merged_into = this;
+}
+
 void Map::erase(KeyFrame& kf) {
   if (&kf == origin) return;  // the origin anchors the map's coordinate frame
   if (kf.parent) kf.T_c_parent = kf.T_cw * kf.parent->pose().inverse();

@@ -62,6 +62,10 @@ class Map {
   void replace(MapPoint& old, const std::shared_ptr<MapPoint>& by);
   // Removes a keyframe: its observations go, its children move to its parent.
   void erase(KeyFrame& kf);
+  // Moves every keyframe and point of `other` into this map, as they are (a merge; the caller
+  // has put them in this map's frame or will), and marks `other` merged into this one. The
+  // caller holds both maps' mutexes.
+  void absorb(Map& other);
 };
 
 }  // namespace hiveslam::core
