@@ -14,5 +14,6 @@ void addVocabCommand(CLI::App& app);
 void addNodeCommand(CLI::App& app);
 void addClusterCommand(CLI::App& app);
 void addBenchCommand(CLI::App& app);
+void addPlayCommand(CLI::App& app);
 
 }  // namespace hiveslam::apps

@@ -20,7 +20,7 @@ void addDemoCommand(CLI::App& app) {
   options->frames = 400;
   cmd->add_option("--out", *out, "Output folder")->capture_default_str();
   cmd->add_option("--frames", options->frames, "Frames to render")->capture_default_str();
-  cmd->add_option("--trajectory", options->trajectory, "loop | figure8 | blackout | sweep")->capture_default_str();
+  cmd->add_option("--trajectory", options->trajectory, "loop | figure8 | blackout | sweep | bigloop")->capture_default_str();
   cmd->add_option("--repeats", *repeats, "Runs per configuration")->capture_default_str();
   cmd->callback([=]() {
     const std::filesystem::path root(*out);

@@ -27,7 +27,7 @@ std::atomic<bool> g_stop{false};
 extern "C" void onSignal(int) { g_stop = true; }
 
 struct NodeCommandOptions {
-  std::string task = "tr", name, dataset, out, config, times, expect;
+  std::string task = "tr", name, dataset, out, config, times, expect, topic, calibration;
   int domain = 0, id = 0;
   bool realtime = false, no_loop_closing = false;
   int wait_seconds = 20;
@@ -45,8 +45,10 @@ void serve(const NodeCommandOptions& o, communication::Task task) {
   const uint16_t id = o.id > 0 ? static_cast<uint16_t>(o.id) : defaultId(task);
   core::SlamSystem slam(settings, nullptr, core::SlamSystem::Mode::Offline, vocabulary, id);
   communication::DdsTransport transport({o.domain});
-  distribution::DistributedNode node(slam, transport,
-                                     {task, id, o.name.empty() ? communication::taskName(task) : o.name, {}});
+  distribution::DistributionSettings distribution_settings;
+  if (!o.config.empty()) io::applyDistributionSettings(o.config, distribution_settings);
+  distribution::DistributedNode node(
+      slam, transport, {task, id, o.name.empty() ? communication::taskName(task) : o.name, distribution_settings});
   std::signal(SIGINT, onSignal);
   std::signal(SIGTERM, onSignal);
   node.start();
@@ -55,6 +57,7 @@ void serve(const NodeCommandOptions& o, communication::Task task) {
   while (!g_stop && !(done = node.waitUntilDone(std::chrono::milliseconds(200)))) {
   }
   nlohmann::json report = node.report(monitor.wallSeconds());
+  report["thread_cpu_seconds"] = eval::ResourceMonitor::threadCpuSeconds();  // before threads end
   node.stop();
   slam.finish();
   const auto& ms = slam.mappingStats();
@@ -67,13 +70,15 @@ void serve(const NodeCommandOptions& o, communication::Task task) {
   report["loops"] = ls.loops;
   report["merges"] = ls.merges;
   report["global_bas"] = ls.global_bas;
-  size_t kfs = 0;
+  size_t kfs = 0, points = 0;
   report["map_keyframes"] = nlohmann::json::array();
   for (const auto& m : slam.liveMaps()) {
     std::lock_guard lock(m->mutex);
     kfs += m->keyframes.size();
+    points += m->points.size();
     report["map_keyframes"].push_back(m->keyframes.size());
   }
+  report["map_points"] = points;
   report["keyframes"] = kfs;
   report["maps"] = report["map_keyframes"].size();
   report["cpu_seconds"] = monitor.cpuSeconds();
@@ -94,6 +99,8 @@ void addNodeCommand(CLI::App& app) {
   auto o = std::make_shared<NodeCommandOptions>();
   cmd->add_option("--task", o->task, "tr (tracking), lm (local mapping) or lc (loop closing)")->required();
   cmd->add_option("DATASET", o->dataset, "TR's input: what `hiveslam run` reads");
+  cmd->add_option("--topic", o->topic, "TR's input instead of a DATASET: a ROS 2 sensor_msgs/msg/Image topic (e.g. /camera/image_raw)");
+  cmd->add_option("--calibration", o->calibration, "TR with --topic: camera file (settings YAML, sensor.yaml or calib.txt)");
   cmd->add_option("--out", o->out, "Output folder")->required();
   cmd->add_option("--domain", o->domain, "DDS domain id (the ROS_DOMAIN_ID)")->capture_default_str();
   cmd->add_option("--name", o->name, "Node name (default: the task)");
@@ -110,17 +117,20 @@ void addNodeCommand(CLI::App& app) {
     if (o->domain < 0 || o->domain > 232) throw InputError("DDS domain must be 0-232");
     if (o->id < 0 || o->id > 65535) throw InputError("node id must be 1-65535");
     if (task != communication::Task::Tracking) {
-      if (!o->dataset.empty()) throw InputError("only a tr node reads a dataset");
+      if (!o->dataset.empty() || !o->topic.empty()) throw InputError("only a tr node reads images");
       serve(*o, task);
       return;
     }
-    if (o->dataset.empty()) throw InputError("a tr node needs a DATASET");
+    if (o->dataset.empty() == o->topic.empty()) throw InputError("a tr node reads a DATASET or a --topic (one of them)");
     RunOptions run;
     run.dataset = o->dataset;
     run.out = o->out;
     run.config = o->config;
     run.times = o->times;
     run.realtime = o->realtime;
+    run.topic = o->topic;
+    run.calibration = o->calibration;
+    run.topic_domain = o->domain;
     run.no_loop_closing = o->no_loop_closing;
     run.network.enabled = true;
     run.network.domain = o->domain;

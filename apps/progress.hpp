@@ -10,7 +10,13 @@ namespace hiveslam::apps {
 class Progress {
  public:
   explicit Progress(std::string label) : label_(std::move(label)), tty_(isatty(fileno(stderr))) {}
+  // `total` 0: not known up front (a live topic); then every 100.
   void update(int done, int total) {
+    if (total <= 0) {
+      if (tty_) std::fprintf(stderr, "\r%s %d", label_.c_str(), done);
+      else if (done % 100 == 0) std::fprintf(stderr, "%s %d\n", label_.c_str(), done);
+      return;
+    }
     const int percent = total > 0 ? 100 * done / total : 0;
     if (tty_) {
       std::fprintf(stderr, "\r%s %d/%d (%d%%)", label_.c_str(), done, total, percent);

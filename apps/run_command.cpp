@@ -12,6 +12,7 @@
 #include "apps/commands.hpp"
 #include "apps/run_slam.hpp"
 #include "apps/progress.hpp"
+#include "apps/topic_frame_source.hpp"
 #include "common/error.hpp"
 #include "communication/dds/dds_transport.hpp"
 #include "distribution/distributed_node.hpp"
@@ -42,7 +43,17 @@ RunSummary runSlam(const RunOptions& o) {
   io::DatasetOptions dataset_options;
   if (!o.config.empty()) dataset_options.settings = o.config;
   if (!o.times.empty()) dataset_options.times = o.times;
-  auto source = io::openDataset(o.dataset, dataset_options);
+  std::unique_ptr<io::FrameSource> source;
+  if (o.topic.empty()) {
+    source = io::openDataset(o.dataset, dataset_options);
+  } else {
+    const std::string calibration = o.calibration.empty() ? o.config : o.calibration;
+    if (calibration.empty()) throw InputError("an image topic carries no calibration: pass --calibration FILE");
+    source = std::make_unique<TopicFrameSource>(o.topic_domain, o.topic, io::loadCameraFile(calibration),
+                                                std::chrono::seconds(o.topic_wait_seconds), std::chrono::seconds(3));
+  }
+  // A live topic paces itself; a dataset is paced here in real-time mode.
+  const bool pace = o.realtime && o.topic.empty();
   const std::filesystem::path out(o.out);
   std::filesystem::create_directories(out);
   fmt::print(stderr, "{}\n", source->describe());
@@ -50,7 +61,7 @@ RunSummary runSlam(const RunOptions& o) {
   core::SlamSettings settings;
   if (!o.config.empty()) io::applySlamSettings(o.config, settings);
   const auto mode = o.sequential ? core::SlamSystem::Mode::Sequential
-                    : o.realtime ? core::SlamSystem::Mode::Realtime
+                    : o.realtime || !o.topic.empty() ? core::SlamSystem::Mode::Realtime
                                  : core::SlamSystem::Mode::Offline;
   if (o.no_loop_closing || o.localization) settings.loop_closing = false;
   if (o.localization && o.atlas_in.empty()) throw InputError("--localization needs --atlas-in FILE");
@@ -60,9 +71,12 @@ RunSummary runSlam(const RunOptions& o) {
   std::unique_ptr<communication::DdsTransport> transport;
   std::unique_ptr<distribution::DistributedNode> node;
   if (o.network.enabled) {
+    distribution::DistributionSettings distribution_settings;
+    if (!o.config.empty()) io::applyDistributionSettings(o.config, distribution_settings);
     transport = std::make_unique<communication::DdsTransport>(communication::DdsOptions{o.network.domain});
     node = std::make_unique<distribution::DistributedNode>(
-        slam, *transport, distribution::NodeOptions{communication::Task::Tracking, o.network.id, o.network.name, {}});
+        slam, *transport,
+        distribution::NodeOptions{communication::Task::Tracking, o.network.id, o.network.name, distribution_settings});
     node->start();
     uint8_t want = 0;
     for (const auto& t : o.network.expect) {
@@ -91,7 +105,7 @@ RunSummary runSlam(const RunOptions& o) {
   const auto wall_start = std::chrono::steady_clock::now();
   double first_stamp = -1, last_stamp = -1;
   while (auto frame = source->next()) {
-    if (o.realtime) {
+    if (pace) {
       // A camera does not wait: a frame whose time has passed by more than a frame period
       // while the previous one was processed is dropped.
       if (first_stamp < 0) first_stamp = frame->timestamp;
@@ -111,7 +125,7 @@ RunSummary runSlam(const RunOptions& o) {
       fmt::print(stderr, "frame {} t {:.3f} {} inliers {} {}\n", r.index, r.timestamp, r.tracked ? "tracked" : "LOST",
                  r.inliers, r.keyframe ? "keyframe" : "");
     else
-      progress.update(++n, std::max(total, n));
+      progress.update(++n, total > 0 ? std::max(total, n) : 0);
     if (o.verbose) ++n;
     if (o.max_frames > 0 && n >= o.max_frames) break;
   }
@@ -120,8 +134,10 @@ RunSummary runSlam(const RunOptions& o) {
     if (!node->finishRun(std::chrono::seconds(120)))
       fmt::print(stderr, "warning: the end-of-run exchange did not complete; the maps may differ between nodes\n");
     node_report = node->report(monitor.wallSeconds());
-    node->stop();
   }
+  // Before the threads end: a thread that has ended is no longer in /proc.
+  const auto thread_cpu = eval::ResourceMonitor::threadCpuSeconds();
+  if (node) node->stop();
   slam.finish();
 
   // Trajectory: every tracked frame of the largest map, through its reference keyframe.
@@ -157,6 +173,9 @@ RunSummary runSlam(const RunOptions& o) {
   report["maps"] = maps.size();
   report["map_keyframes"] = nlohmann::json::array();
   for (const auto& m : maps) report["map_keyframes"].push_back(m->keyframes.size());
+  size_t point_count = 0;
+  for (const auto& m : maps) point_count += m->points.size();
+  report["map_points"] = point_count;
   const auto& ls = slam.loopStats();
   report["loop_closing"] = settings.loop_closing;
   report["loops"] = ls.loops;
@@ -176,10 +195,14 @@ RunSummary runSlam(const RunOptions& o) {
                            {"rejected_geometry", ls.rejected_geometry},
                            {"global_bas_discarded", ls.global_bas_discarded},
                            {"global_ba_ms", ls.global_ba_ms}};
-  report["mode"] = o.sequential ? "sequential" : o.realtime ? "realtime" : "offline";
+  if (const auto* topic = dynamic_cast<const TopicFrameSource*>(source.get()))
+    dropped += static_cast<int>(topic->dropped());  // images the reader had to let go
+  const bool realtime = mode == core::SlamSystem::Mode::Realtime;
+  report["mode"] = o.sequential ? "sequential" : realtime ? "realtime" : "offline";
   report["localization_only"] = o.localization;
-  if (o.realtime) report["dropped_frames"] = dropped;
+  if (realtime) report["dropped_frames"] = dropped;
   report["cpu_seconds"] = monitor.cpuSeconds();
+  report["thread_cpu_seconds"] = thread_cpu;
   report["wall_seconds"] = monitor.wallSeconds();
   report["cpu_percent"] = monitor.cpuPercent();
   report["peak_rss_mb"] = eval::ResourceMonitor::peakRssBytes() / 1048576.0;

@@ -16,6 +16,11 @@ struct RunOptions {
   std::string atlas_in, atlas_out;  // load maps before the run / save them after it
   bool localization = false;         // track against atlas_in without mapping
   int max_frames = 0;
+  // Instead of a dataset: a ROS 2 sensor_msgs/msg/Image topic on DDS domain topic_domain, with
+  // the calibration from a file (settings YAML, sensor.yaml or calib.txt).
+  std::string topic, calibration;
+  int topic_domain = 0;
+  int topic_wait_seconds = 30;  // for the first image
   // As the TR node of a distributed system (hiveslam node --task tr): on a DDS domain, waiting
   // for the peers it expects before the first frame.
   struct Network {

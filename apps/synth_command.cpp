@@ -38,7 +38,7 @@ void addSynthCommand(CLI::App& app) {
   auto out = std::make_shared<std::string>();
   auto size = std::make_shared<std::string>("752x480");
   auto suite_name = std::make_shared<std::string>();
-  cmd->add_option("--trajectory", o->trajectory, "loop | figure8 | blackout | sweep")->capture_default_str();
+  cmd->add_option("--trajectory", o->trajectory, "loop | figure8 | blackout | sweep | bigloop")->capture_default_str();
   cmd->add_option("--seed", o->seed, "Varies textures, scene layout and the exact path")->capture_default_str();
   cmd->add_option("--frames", o->frames, "Number of frames")->capture_default_str()->check(CLI::Range(2, 1000000));
   cmd->add_option("--size", *size, "Image size WxH")->capture_default_str();

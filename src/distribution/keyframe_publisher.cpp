@@ -4,6 +4,7 @@
 
 #include <set>
 
+#include "common/thread_name.hpp"
 #include "distribution/packet.hpp"
 #include "distribution/state_capture.hpp"
 
@@ -12,7 +13,10 @@ namespace hiveslam::distribution {
 KeyframePublisher::KeyframePublisher(communication::Transport& transport, Observer& observer, SentLedger& ledger,
                                      uint16_t node, Known known)
     : transport_(transport), observer_(observer), ledger_(ledger), node_(node), known_(std::move(known)) {
-  thread_ = std::thread([this] { loop(); });
+  thread_ = std::thread([this] {
+    nameThisThread("kf-publisher");
+    loop();
+  });
 }
 
 KeyframePublisher::~KeyframePublisher() { finish(); }

@@ -2,13 +2,17 @@
 
 #include <spdlog/spdlog.h>
 
+#include "common/thread_name.hpp"
 #include "distribution/packet.hpp"
 
 namespace hiveslam::distribution {
 
 KeyframeSubscriber::KeyframeSubscriber(StateIntegrator& integrator, Route route, OnControl control)
     : integrator_(integrator), route_(std::move(route)), control_(std::move(control)) {
-  thread_ = std::thread([this] { loop(); });
+  thread_ = std::thread([this] {
+    nameThisThread("kf-subscriber");
+    loop();
+  });
 }
 
 KeyframeSubscriber::~KeyframeSubscriber() { finish(); }

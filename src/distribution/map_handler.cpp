@@ -4,6 +4,7 @@
 
 #include <algorithm>
 
+#include "common/thread_name.hpp"
 #include "distribution/packet.hpp"
 #include "distribution/state_capture.hpp"
 
@@ -32,7 +33,10 @@ MapHandler::MapHandler(communication::Transport& transport, StateIntegrator& int
       settings_(settings),
       node_(node),
       hooks_(std::move(hooks)) {
-  thread_ = std::thread([this] { loop(); });
+  thread_ = std::thread([this] {
+    nameThisThread("map-handler");
+    loop();
+  });
 }
 
 MapHandler::~MapHandler() { finish(); }

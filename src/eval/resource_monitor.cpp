@@ -2,6 +2,7 @@
 
 #include <unistd.h>
 
+#include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <sstream>
@@ -11,8 +12,11 @@ namespace hiveslam::eval {
 ResourceMonitor::ResourceMonitor()
     : start_(std::chrono::steady_clock::now()), cpu_start_(processCpuSeconds()) {}
 
-double ResourceMonitor::processCpuSeconds() {
-  std::ifstream in("/proc/self/stat");
+namespace {
+
+// utime + stime of a /proc stat file, in seconds.
+double statCpuSeconds(const std::string& path) {
+  std::ifstream in(path);
   std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   // The command name (field 2) may hold spaces: parse after its closing parenthesis.
   const size_t close = text.rfind(')');
@@ -25,6 +29,22 @@ double ResourceMonitor::processCpuSeconds() {
     if (i == 15) stime = std::stoull(field);
   }
   return static_cast<double>(utime + stime) / static_cast<double>(sysconf(_SC_CLK_TCK));
+}
+
+}  // namespace
+
+double ResourceMonitor::processCpuSeconds() { return statCpuSeconds("/proc/self/stat"); }
+
+std::map<std::string, double> ResourceMonitor::threadCpuSeconds() {
+  std::map<std::string, double> per_name;
+  std::error_code ec;
+  for (const auto& task : std::filesystem::directory_iterator("/proc/self/task", ec)) {
+    std::ifstream comm(task.path() / "comm");
+    std::string name;
+    if (!std::getline(comm, name)) continue;
+    per_name[name] += statCpuSeconds(task.path() / "stat");
+  }
+  return per_name;
 }
 
 uint64_t ResourceMonitor::peakRssBytes() {

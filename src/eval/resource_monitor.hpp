@@ -22,6 +22,9 @@ class ResourceMonitor {
   static double processCpuSeconds();
   // Peak resident set size of the process, bytes.
   static uint64_t peakRssBytes();
+  // CPU seconds of the threads alive now, summed per thread name (threads that already
+  // ended are not in it): where a process spends its time.
+  static std::map<std::string, double> threadCpuSeconds();
 
   double wallSeconds() const;
   double cpuSeconds() const;  // since this monitor was made

@@ -152,6 +152,11 @@ CameraSettings loadCalibTxt(const std::filesystem::path& path) {
   return s;
 }
 
+CameraSettings loadCameraFile(const std::filesystem::path& path) {
+  if (path.extension() == ".txt") return loadCalibTxt(path);
+  return loadYaml(path)["camera"] ? loadSettingsCamera(path) : loadEurocSensorYaml(path);
+}
+
 void writeSettingsCamera(const std::filesystem::path& path, const camera::CameraModel& camera,
                          double fps) {
   const auto p = camera.parameters();

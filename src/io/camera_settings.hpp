@@ -31,6 +31,10 @@ CameraSettings loadSettingsCamera(const std::filesystem::path& settings_yaml);
 CameraSettings loadEurocSensorYaml(const std::filesystem::path& sensor_yaml);
 CameraSettings loadCalibTxt(const std::filesystem::path& calib_txt);
 
+// Any of the three, told apart by content: `.txt` is calib.txt, a YAML with a `camera:`
+// section is a settings file, any other YAML a sensor.yaml.
+CameraSettings loadCameraFile(const std::filesystem::path& path);
+
 // Writes the `camera:` section of a settings file (used by `hiveslam synth`).
 void writeSettingsCamera(const std::filesystem::path& path, const camera::CameraModel& camera,
                          double fps);

@@ -16,18 +16,39 @@ std::function<void(const YAML::Node&)> set(T& field) {
   return [&field](const YAML::Node& n) { field = n.as<T>(); };
 }
 
-}  // namespace
+using KeyTable = std::map<std::string, std::function<void(const YAML::Node&)>>;
 
-void applySlamSettings(const std::filesystem::path& file, core::SlamSettings& s) {
-  YAML::Node root;
+YAML::Node load(const std::filesystem::path& file) {
   try {
-    root = YAML::LoadFile(file.string());
+    return YAML::LoadFile(file.string());
   } catch (const YAML::Exception& e) {
     throw InputError(file.string() + ": " + e.msg);
   }
+}
+
+// Sets every key of `section` through `table`; `skip` is a sub-section handled elsewhere.
+void apply(const std::filesystem::path& file, const YAML::Node& section, const KeyTable& table,
+           const std::string& prefix, const std::string& skip = "") {
+  for (const auto& kv : section) {
+    const std::string key = kv.first.as<std::string>();
+    if (key == skip) continue;
+    const auto it = table.find(key);
+    if (it == table.end()) throw InputError(file.string() + ": unknown setting '" + prefix + key + "'");
+    try {
+      it->second(kv.second);
+    } catch (const YAML::Exception&) {
+      throw InputError(file.string() + ": setting '" + prefix + key + "' has the wrong type");
+    }
+  }
+}
+
+}  // namespace
+
+void applySlamSettings(const std::filesystem::path& file, core::SlamSettings& s) {
+  const YAML::Node root = load(file);
   const YAML::Node slam = root["slam"];
   if (!slam) return;
-  const std::map<std::string, std::function<void(const YAML::Node&)>> keys{
+  const KeyTable keys{
       {"init_min_matches", set(s.init_min_matches)},
       {"init_min_parallax_deg", set(s.init_min_parallax_deg)},
       {"init_min_points", set(s.init_min_points)},
@@ -58,7 +79,7 @@ void applySlamSettings(const std::filesystem::path& file, core::SlamSettings& s)
       {"vocabulary", set(s.vocabulary)},
       {"seed", set(s.seed)},
   };
-  const std::map<std::string, std::function<void(const YAML::Node&)>> orb_keys{
+  const KeyTable orb_keys{
       {"features", set(s.orb.features)},
       {"scale_factor", set(s.orb.scale_factor)},
       {"levels", set(s.orb.levels)},
@@ -66,21 +87,28 @@ void applySlamSettings(const std::filesystem::path& file, core::SlamSettings& s)
       {"min_fast_threshold", set(s.orb.min_fast_threshold)},
       {"cell_size", set(s.orb.cell_size)},
   };
-  auto apply = [&](const YAML::Node& section, const auto& table, const std::string& prefix) {
-    for (const auto& kv : section) {
-      const std::string key = kv.first.as<std::string>();
-      if (prefix.empty() && key == "orb") continue;
-      const auto it = table.find(key);
-      if (it == table.end()) throw InputError(file.string() + ": unknown setting '" + prefix + key + "'");
-      try {
-        it->second(kv.second);
-      } catch (const YAML::Exception&) {
-        throw InputError(file.string() + ": setting '" + prefix + key + "' has the wrong type");
-      }
-    }
+  apply(file, slam, keys, "", "orb");
+  if (slam["orb"]) apply(file, slam["orb"], orb_keys, "orb.");
+}
+
+void applyDistributionSettings(const std::filesystem::path& file, distribution::DistributionSettings& s) {
+  const YAML::Node section = load(file)["distribution"];
+  if (!section) return;
+  const KeyTable keys{
+      {"local_first_batch", set(s.local_first_batch)},
+      {"local_max_batch", set(s.local_max_batch)},
+      {"local_batch_gap_ms", set(s.local_batch_gap_ms)},
+      {"local_window", set(s.local_window)},
+      {"min_point_move", set(s.min_point_move)},
+      {"global_batch", set(s.global_batch)},
+      {"global_batch_gap_ms", set(s.global_batch_gap_ms)},
+      {"remote_mapping_wait_ms", set(s.remote_mapping_wait_ms)},
   };
-  apply(slam, keys, "");
-  if (slam["orb"]) apply(slam["orb"], orb_keys, "orb.");
+  apply(file, section, keys, "distribution.");
+  if (s.local_first_batch < 1 || s.local_max_batch < s.local_first_batch || s.global_batch < 1 ||
+      s.local_batch_gap_ms < 0 || s.global_batch_gap_ms < 0 || s.local_window < 1 || s.min_point_move < 0 ||
+      s.remote_mapping_wait_ms < 0)
+    throw InputError(file.string() + ": distribution settings out of range (batches >= 1, first <= max, times >= 0)");
 }
 
 }  // namespace hiveslam::io

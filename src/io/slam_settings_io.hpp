@@ -2,6 +2,7 @@
 #include <filesystem>
 
 #include "core/system/slam_settings.hpp"
+#include "distribution/distribution_settings.hpp"
 
 namespace hiveslam::io {
 
@@ -9,5 +10,9 @@ namespace hiveslam::io {
 // options under `slam: orb:`). Unknown keys are an error naming the file: a typo must not
 // silently fall back to a default.
 void applySlamSettings(const std::filesystem::path& file, core::SlamSettings& settings);
+
+// Applies the `distribution:` section (keys as in DistributionSettings), checked the same way
+// and for ranges.
+void applyDistributionSettings(const std::filesystem::path& file, distribution::DistributionSettings& settings);
 
 }  // namespace hiveslam::io

@@ -14,13 +14,13 @@ std::vector<SuiteEntry> suite(const std::string& name) {
     return o;
   };
   std::vector<SuiteEntry> entries{
-      {"loop", make("loop", 1, 1000)},
       {"figure8", make("figure8", 2, 1000)},
       {"blackout", make("blackout", 3, 1000)},
       {"sweep", make("sweep", 4, 800)},
+      {"bigloop", make("bigloop", 5, 1000)},
   };
-  entries[0].options.distortion = true;
-  entries[1].options.exposure_changes = true;
+  entries[0].options.exposure_changes = true;
+  entries[2].options.distortion = true;
   return entries;
 }
 

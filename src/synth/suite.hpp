@@ -12,8 +12,9 @@ struct SuiteEntry {
   SequenceOptions options;
 };
 
-// "standard": loop (EuRoC-like lens distortion), figure8 (exposure changes), blackout
-// (a blank transit), sweep (no revisit); all 752x480 at 20 fps with sensor noise.
+// "standard": figure8 (exposure changes), blackout (a blank transit), sweep (EuRoC-like lens
+// distortion; no revisit), bigloop (a wide lap close to the walls, with the drift a loop
+// closure has to remove); all 752x480 at 20 fps with sensor noise.
 std::vector<SuiteEntry> suite(const std::string& name);
 
 }  // namespace hiveslam::synth

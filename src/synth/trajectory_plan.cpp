@@ -7,7 +7,7 @@
 namespace hiveslam::synth {
 
 const std::vector<std::string>& trajectoryKinds() {
-  static const std::vector<std::string> kinds{"loop", "figure8", "blackout", "sweep"};
+  static const std::vector<std::string> kinds{"loop", "figure8", "blackout", "sweep", "bigloop"};
   return kinds;
 }
 
@@ -40,6 +40,21 @@ TrajectoryPlan planTrajectory(const std::string& kind, const Eigen::Vector3d& ro
       plan.waypoints.push_back(look(eye, th + 35.0 * M_PI / 180.0));
     }
     plan.description = "1.15 laps of an ellipse looking outwards; returns to its start";
+  } else if (kind == "bigloop") {
+    // Close to the walls, looking at them 55 degrees ahead of the heading: the view changes
+    // fast, keyframes share few points with those a few metres back, and monocular scale
+    // drift builds up over the lap; the drift a loop closure has to remove.
+    const double a = hx - 1.5, b = hy - 1.5;
+    const int per_lap = 16;
+    const int n = static_cast<int>(per_lap * 1.12) + 1;
+    for (int k = 0; k <= n; ++k) {
+      const double th = 2 * M_PI * k / per_lap;
+      const Eigen::Vector3d eye(a * std::cos(th) + (k % per_lap ? jitter(0.1) : 0),
+                                b * std::sin(th) + (k % per_lap ? jitter(0.1) : 0), height());
+      const double heading = std::atan2(b * std::cos(th), -a * std::sin(th));
+      plan.waypoints.push_back(look(eye, heading - 55.0 * M_PI / 180.0, 2.0));
+    }
+    plan.description = "1.12 laps near the walls looking at them; drift builds up before the return";
   } else if (kind == "figure8") {
     // Lemniscate of Gerono through the room centre, looking 40 degrees left of the heading.
     const double a = 0.45 * hx, b = 0.6 * hy;
@@ -84,7 +99,7 @@ TrajectoryPlan planTrajectory(const std::string& kind, const Eigen::Vector3d& ro
       plan.waypoints.push_back(look({x - 2 * x * k / 5, -y + jitter(0.15), height()}, south + 0.35 * std::sin(k * 1.3)));
     plan.description = "along the north wall, round the east end, back along the south wall; no revisit";
   } else {
-    throw InputError("unknown trajectory '" + kind + "' (loop, figure8, blackout, sweep)");
+    throw InputError("unknown trajectory '" + kind + "' (loop, figure8, blackout, sweep, bigloop)");
   }
   return plan;
 }

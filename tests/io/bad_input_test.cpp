@@ -11,6 +11,7 @@
 #include "io/camera_settings.hpp"
 #include "io/image_file.hpp"
 #include "io/open_dataset.hpp"
+#include "io/slam_settings_io.hpp"
 #include "synth/sequence.hpp"
 #include "temp_dir.hpp"
 
@@ -162,6 +163,35 @@ TEST(BadInput, CommandLinePrintsOneLineAndFails) {
   EXPECT_NE(WEXITSTATUS(status), 0);
   EXPECT_EQ(std::count(out.begin(), out.end(), '\n'), 1) << out;
   EXPECT_NE(out.find("dataset not found: /nonexistent/hiveslam/dataset"), std::string::npos) << out;
+}
+
+TEST(BadInput, DistributionSettingsAreReadAndChecked) {
+  testing::TempDir dir;
+  const fs::path file = dir / "settings.yaml";
+  std::ofstream(file) << "distribution:\n  local_max_batch: 8\n  global_batch_gap_ms: 40\n  min_point_move: 0.001\n";
+  distribution::DistributionSettings s;
+  applyDistributionSettings(file, s);
+  EXPECT_EQ(s.local_max_batch, 8);
+  EXPECT_EQ(s.global_batch_gap_ms, 40);
+  EXPECT_DOUBLE_EQ(s.min_point_move, 0.001);
+  EXPECT_EQ(s.local_first_batch, 3);  // untouched keys keep the paper's values
+  std::ofstream(file) << "distribution:\n  local_max_bach: 8\n";
+  EXPECT_NE(errorOf([&] { applyDistributionSettings(file, s); }).find("distribution.local_max_bach"), std::string::npos);
+  std::ofstream(file) << "distribution:\n  local_first_batch: 9\n  local_max_batch: 4\n";
+  EXPECT_NE(errorOf([&] { applyDistributionSettings(file, s); }).find("out of range"), std::string::npos);
+  std::ofstream(file) << "distribution:\n  global_batch: ten\n";
+  EXPECT_NE(errorOf([&] { applyDistributionSettings(file, s); }).find("wrong type"), std::string::npos);
+}
+
+TEST(BadInput, ACameraFileIsRecognisedByItsContent) {
+  testing::TempDir dir;
+  const fs::path seq = makeSequence(dir);
+  EXPECT_EQ(loadCameraFile(seq / "mav0/cam0/sensor.yaml").camera->width(), 96);
+  const fs::path settings = dir / "camera.yaml";
+  writeSettingsCamera(settings, *loadCameraFile(seq / "mav0/cam0/sensor.yaml").camera, 20);
+  EXPECT_EQ(loadCameraFile(settings).camera->height(), 64);
+  std::ofstream(dir / "calib.txt") << "fx 1\n";
+  EXPECT_NE(errorOf([&] { loadCameraFile(dir / "calib.txt"); }).find("calib.txt"), std::string::npos);
 }
 
 }  // namespace

@@ -23,6 +23,7 @@
 
 #include "common/blocking_queue.hpp"
 #include "common/error.hpp"
+#include "common/thread_name.hpp"
 #include "hiveslam_msgs/msg/NodeInfoPubSubTypes.h"
 #include "hiveslam_msgs/msg/PacketPubSubTypes.h"
 
@@ -176,6 +177,7 @@ struct DdsTransport::Impl : public dds::DomainParticipantListener {
   dds::DataWriter* writerFor(Topic t) {
     auto& w = writers[static_cast<size_t>(t)];
     if (w) return w;
+    const ScopedThreadName name("fastdds");
     dds::DataWriterQos q = dds::DATAWRITER_QOS_DEFAULT;
     q.reliability().kind = dds::RELIABLE_RELIABILITY_QOS;
     q.reliability().max_blocking_time = Duration_t(0, 50'000'000);
@@ -204,6 +206,7 @@ DdsTransport::~DdsTransport() { stop(); }
 
 void DdsTransport::start(const PeerInfo& self, PeerHandler on_peer) {
   Impl& d = *impl_;
+  const ScopedThreadName name("fastdds");
   dds::DomainParticipantQos pq = dds::PARTICIPANT_QOS_DEFAULT;
   pq.name(self.name.empty() ? "hiveslam" : self.name);
   auto& discovery = pq.wire_protocol().builtin.discovery_config;
@@ -247,6 +250,7 @@ void DdsTransport::start(const PeerInfo& self, PeerHandler on_peer) {
     d.running = true;
   }
   d.peer_thread = std::thread([&d] {
+    nameThisThread("dds-peers");
     while (auto e = d.peer_events.pop())
       if (d.on_peer) d.on_peer(e->first, e->second);
   });
@@ -255,6 +259,7 @@ void DdsTransport::start(const PeerInfo& self, PeerHandler on_peer) {
   if (!d.node_writer || !d.node_reader) throw InputError("DDS: cannot create the discovery topic");
   // Announcements repeat once a second: the load changes, and a peer that missed one catches up.
   d.heartbeat = std::thread([&d] {
+    nameThisThread("dds-heartbeat");
     std::unique_lock lock(d.mutex);
     while (d.running) {
       d.wake.wait_for(lock, std::chrono::seconds(1));
@@ -304,6 +309,7 @@ void DdsTransport::subscribe(Topic topic, Handler handler) {
   r->impl = &d;
   r->topic = topic;
   r->handler = std::move(handler);
+  const ScopedThreadName name("fastdds");
   dds::DataReaderQos q = dds::DATAREADER_QOS_DEFAULT;
   q.reliability().kind = dds::RELIABLE_RELIABILITY_QOS;
   q.history().kind = dds::KEEP_LAST_HISTORY_QOS;

@@ -1,6 +1,7 @@
 #include "core/features/orb_extractor.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <opencv2/features2d.hpp>
 #include <opencv2/imgproc.hpp>
@@ -78,37 +79,44 @@ std::vector<cv::KeyPoint> distribute(const std::vector<cv::KeyPoint>& kps, const
   return out;
 }
 
-// Orientation by the intensity centroid of a disc of radius kHalfPatch, in degrees.
+// Orientation by the intensity centroid of a disc of radius kHalfPatch, in degrees. Integer
+// moments: exact, and several times faster than accumulating doubles.
 float orientation(const cv::Mat& img, cv::Point2f pt) {
   const int cx = cvRound(pt.x), cy = cvRound(pt.y);
-  double m01 = 0, m10 = 0;
+  static const std::array<int, kHalfPatch + 1> span = [] {
+    std::array<int, kHalfPatch + 1> s{};
+    for (int d = 0; d <= kHalfPatch; ++d) s[static_cast<size_t>(d)] = static_cast<int>(std::sqrt(kHalfPatch * kHalfPatch - d * d + 0.5));
+    return s;
+  }();
+  int m01 = 0, m10 = 0;
   for (int dy = -kHalfPatch; dy <= kHalfPatch; ++dy) {
-    const uchar* row = img.ptr<uchar>(cy + dy);
-    const int span = static_cast<int>(std::sqrt(kHalfPatch * kHalfPatch - dy * dy + 0.5));
-    for (int dx = -span; dx <= span; ++dx) {
-      const double v = row[cx + dx];
-      m10 += dx * v;
-      m01 += dy * v;
+    const uchar* row = img.ptr<uchar>(cy + dy) + cx;
+    const int w = span[static_cast<size_t>(std::abs(dy))];
+    int sum = 0, moment = 0;
+    for (int dx = -w; dx <= w; ++dx) {
+      sum += row[dx];
+      moment += dx * row[dx];
     }
+    m10 += moment;
+    m01 += dy * sum;
   }
-  float a = static_cast<float>(std::atan2(m01, m10) * 180.0 / CV_PI);
+  float a = static_cast<float>(std::atan2(static_cast<double>(m01), static_cast<double>(m10)) * 180.0 / CV_PI);
   return a < 0 ? a + 360.0f : a;
 }
 
+// The 256 tests of the rotated pattern, pixels read by their offset from the centre.
 void describe(const cv::Mat& smooth, const cv::KeyPoint& kp, cv::Point2f at, uchar* out) {
   const auto& pattern = briefPattern();
   const float a = kp.angle * static_cast<float>(CV_PI / 180.0);
   const float c = std::cos(a), s = std::sin(a);
-  const int cx = cvRound(at.x), cy = cvRound(at.y);
-  auto value = [&](int x, int y) {
-    const int rx = cvRound(c * x - s * y), ry = cvRound(s * x + c * y);
-    return smooth.at<uchar>(cy + ry, cx + rx);
-  };
+  const uchar* centre = smooth.ptr<uchar>(cvRound(at.y)) + cvRound(at.x);
+  const int step = static_cast<int>(smooth.step1());
+  auto offset = [&](int x, int y) { return cvRound(s * x + c * y) * step + cvRound(c * x - s * y); };
   for (int byte = 0; byte < 32; ++byte) {
     uchar v = 0;
     for (int bit = 0; bit < 8; ++bit) {
       const auto& p = pattern[static_cast<size_t>(byte * 8 + bit)];
-      if (value(p[0], p[1]) < value(p[2], p[3])) v |= static_cast<uchar>(1u << bit);
+      if (centre[offset(p[0], p[1])] < centre[offset(p[2], p[3])]) v |= static_cast<uchar>(1u << bit);
     }
     out[byte] = v;
   }

@@ -3,6 +3,7 @@
 #include <chrono>
 #include <thread>
 
+#include "common/thread_name.hpp"
 #include "core/mapping/keyframe_insertion.hpp"
 
 namespace hiveslam::core {
@@ -37,8 +38,14 @@ SlamSystem::SlamSystem(const SlamSettings& settings, std::shared_ptr<const camer
     if (events_) events_->globalUpdate(u);
   });
   if (mode_ != Mode::Sequential) {
-    mapping_thread_ = std::thread([this] { mappingLoop(); });
-    if (settings_.loop_closing) loop_thread_ = std::thread([this] { loopLoop(); });
+    mapping_thread_ = std::thread([this] {
+      nameThisThread("local-mapping");
+      mappingLoop();
+    });
+    if (settings_.loop_closing) loop_thread_ = std::thread([this] {
+        nameThisThread("loop-closing");
+        loopLoop();
+      });
   }
   if (mode_ == Mode::Offline) tracker_.setWaitForMapping([this] { waitForMapping(); });
 }

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <opencv2/calib3d.hpp>
 #include <set>
+#include <unordered_set>
 
 #include "core/features/hamming.hpp"
 #include "core/geometry/two_view.hpp"
@@ -305,14 +306,15 @@ bool Tracker::trackLocalMap(Tracked& c, int min_inliers) {
       if (in_local.insert(n).second) local.push_back(n);
   if (best) reference_ = best->shared_from_this();
   // Local points not matched yet.
-  std::set<MapPoint*> matched;
+  std::unordered_set<MapPoint*> matched;
   for (size_t i = 0; i < c.points.size(); ++i)
     if (c.points[i]) {
       if (c.outlier[i]) c.points[i].reset();
       else matched.insert(c.points[i].get());
     }
   std::vector<std::shared_ptr<MapPoint>> candidates;
-  std::set<MapPoint*> seen;
+  std::unordered_set<MapPoint*> seen;  // thousands of points per frame: hashed, not a tree
+  seen.reserve(8192);
   for (KeyFrame* kf : local)
     for (const auto& p : kf->points)
       if (p && !p->bad && !matched.count(p.get()) && seen.insert(p.get()).second) candidates.push_back(p);

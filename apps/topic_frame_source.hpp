@@ -1,0 +1,43 @@
+#pragma once
+// Frames from a ROS 2 sensor_msgs/msg/Image topic, for a TR node fed by a camera driver or by
+// `hiveslam play`. Images carry no calibration: it comes from a file (--calibration). The
+// stream ends when the publisher goes away or nothing arrives for a while.
+#include <chrono>
+#include <memory>
+#include <string>
+
+#include "communication/dds/image_topic.hpp"
+#include "io/frame_source.hpp"
+
+namespace hiveslam::apps {
+
+class TopicFrameSource final : public io::FrameSource {
+ public:
+  // Throws InputError when the topic name is invalid or no participant can be made.
+  TopicFrameSource(int domain, const std::string& ros_topic, io::CameraSettings camera,
+                   std::chrono::milliseconds first_wait, std::chrono::milliseconds idle);
+
+  // Throws InputError on an image of another size than the calibration's or an encoding it
+  // cannot read; drops malformed images with a warning.
+  std::optional<io::Frame> next() override;
+  std::optional<size_t> size() const override { return std::nullopt; }
+  const io::CameraSettings& camera() const override { return camera_; }
+  const std::optional<io::Trajectory>& groundTruth() const override { return no_truth_; }
+  std::string describe() const override;
+  uint64_t dropped() const { return reader_.dropped(); }
+
+ private:
+  std::string topic_;
+  int domain_;
+  communication::ImageTopicReader reader_;
+  io::CameraSettings camera_;
+  std::chrono::milliseconds first_wait_, idle_;
+  std::optional<io::Trajectory> no_truth_;
+  size_t index_ = 0;
+};
+
+// CameraImage -> 8-bit grey (mono8, mono16, rgb8, bgr8, rgba8, bgra8); an empty Mat when the
+// sizes do not add up (a malformed message, dropped); InputError for another encoding.
+cv::Mat toGray(const communication::CameraImage& image);
+
+}  // namespace hiveslam::apps
