@@ -12,6 +12,7 @@ struct BenchOptions {
   int repeats = 1;
   std::vector<int> nodes{1, 3};
   bool realtime = true;
+  bool feed_topic = false;  // TR reads a played image topic instead of the files
 };
 
 struct BenchRow {

@@ -45,6 +45,7 @@ nlohmann::json runBench(const BenchOptions& o) {
         c.dataset = seq;
         c.out = (out / name / fmt::format("{}node_run{}", nodes, r + 1)).string();
         c.realtime = o.realtime;
+        c.feed_topic = o.feed_topic;
         c.config = o.config;
         fmt::print(stderr, "bench: {} {}-node run {}/{}\n", name, nodes, r + 1, o.repeats);
         const auto result = runCluster(c);
@@ -107,6 +108,7 @@ void addBenchCommand(CLI::App& app) {
   cmd->add_option("--nodes", o->nodes, "Configurations (node counts)")->delimiter(',')->capture_default_str();
   cmd->add_option("--config", o->config, "Settings YAML");
   cmd->add_flag("!--offline", o->realtime, "Frames as fast as mapping allows instead of at their timestamps");
+  cmd->add_flag("--feed-topic", o->feed_topic, "Play each dataset as a ROS 2 image topic to TR (the paper's set-up)");
   cmd->callback([o]() {
     if (o->repeats < 1) throw InputError("--repeats must be at least 1");
     fmt::print("{}", benchTable(runBench(*o)));

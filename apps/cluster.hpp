@@ -15,6 +15,10 @@ struct ClusterOptions {
   bool no_loop_closing = false;
   int domain = -1;  // -1: one picked from the process id (concurrent clusters stay apart)
   int timeout_seconds = 900;
+  // The paper's feed: the dataset played as a ROS 2 image topic by a `hiveslam play` process,
+  // so TR gets raw pixels as from a camera driver (and decodes no image files). The
+  // calibration is the dataset's sensor.yaml, or --config.
+  bool feed_topic = false;
 };
 
 struct ClusterResult {

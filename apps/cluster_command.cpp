@@ -84,19 +84,40 @@ ClusterResult runCluster(const ClusterOptions& o) {
     args.insert(args.end(), common.begin(), common.end());
     services.emplace_back(task, spawn(args));
   }
-  // One node is the standalone system: no DDS participant at all.
+  // TR's input: the dataset itself, or (feed_topic) an image topic that a player publishes.
+  std::vector<std::string> input{o.dataset};
+  const std::string topic = "/camera/image_raw";
+  if (o.feed_topic) {
+    std::string calibration = o.config;
+    if (calibration.empty() && fs::exists(fs::path(o.dataset) / "mav0/cam0/sensor.yaml"))
+      calibration = (fs::path(o.dataset) / "mav0/cam0/sensor.yaml").string();
+    if (calibration.empty()) throw InputError("feeding a topic needs the camera calibration: pass --config");
+    input = {"--topic", topic, "--calibration", calibration, "--ground-truth", o.dataset};
+  }
+  // One node is the standalone system: no DDS participant at all (fed from a topic, only the
+  // image reader's).
   std::vector<std::string> tr{"hiveslam"};
   if (o.nodes == 1) {
-    tr.insert(tr.end(), {"run", o.dataset, "--out", (out / "tr").string()});
+    tr.push_back("run");
+    tr.insert(tr.end(), input.begin(), input.end());
+    tr.insert(tr.end(), {"--out", (out / "tr").string()});
+    if (o.feed_topic) tr.insert(tr.end(), {"--domain", std::to_string(domain)});
   } else {
     std::string expect;
     for (const auto& t : tasks) expect += (expect.empty() ? "" : ",") + t;
-    tr.insert(tr.end(), {"node", "--task", "tr", o.dataset, "--domain", std::to_string(domain), "--out",
-                         (out / "tr").string(), "--expect", expect});
+    tr.insert(tr.end(), {"node", "--task", "tr"});
+    tr.insert(tr.end(), input.begin(), input.end());
+    tr.insert(tr.end(), {"--domain", std::to_string(domain), "--out", (out / "tr").string(), "--expect", expect});
   }
   if (o.realtime) tr.push_back("--realtime");
   tr.insert(tr.end(), common.begin(), common.end());
-  const int tr_status = reap(spawn(tr), o.timeout_seconds);
+  const pid_t tr_pid = spawn(tr);
+  pid_t player = 0;
+  if (o.feed_topic)  // the player waits for TR's reader, which TR makes once its peers are there
+    player = spawn({"hiveslam", "play", o.dataset, "--topic", topic, "--domain", std::to_string(domain), "--wait",
+                    "60"});
+  const int tr_status = reap(tr_pid, o.timeout_seconds);
+  if (player && reap(player, 5) != 0) fmt::print(stderr, "cluster: the player did not end cleanly\n");
   // After TR's end-of-run exchange the others finish on their own; a stuck one is stopped.
   for (const auto& [task, pid] : services) {
     const int status = reap(pid, tr_status == 0 ? 30 : 1);
@@ -121,6 +142,7 @@ void addClusterCommand(CLI::App& app) {
   cmd->add_option("--domain", o->domain, "DDS domain id (default: picked from the process id)");
   cmd->add_flag("--realtime", o->realtime, "Feed frames at their timestamps");
   cmd->add_flag("--no-loop-closing", o->no_loop_closing, "Switch loop closing off");
+  cmd->add_flag("--feed-topic", o->feed_topic, "Play the dataset as a ROS 2 image topic to TR (the paper's set-up)");
   cmd->callback([o]() {
     const auto r = runCluster(*o);
     for (const auto& [task, j] : r.reports) {

@@ -27,7 +27,7 @@ std::atomic<bool> g_stop{false};
 extern "C" void onSignal(int) { g_stop = true; }
 
 struct NodeCommandOptions {
-  std::string task = "tr", name, dataset, out, config, times, expect, topic, calibration;
+  std::string task = "tr", name, dataset, out, config, times, expect, topic, calibration, ground_truth;
   int domain = 0, id = 0;
   bool realtime = false, no_loop_closing = false;
   int wait_seconds = 20;
@@ -101,6 +101,7 @@ void addNodeCommand(CLI::App& app) {
   cmd->add_option("DATASET", o->dataset, "TR's input: what `hiveslam run` reads");
   cmd->add_option("--topic", o->topic, "TR's input instead of a DATASET: a ROS 2 sensor_msgs/msg/Image topic (e.g. /camera/image_raw)");
   cmd->add_option("--calibration", o->calibration, "TR with --topic: camera file (settings YAML, sensor.yaml or calib.txt)");
+  cmd->add_option("--ground-truth", o->ground_truth, "TR: score against this dataset's ground truth (for --topic)");
   cmd->add_option("--out", o->out, "Output folder")->required();
   cmd->add_option("--domain", o->domain, "DDS domain id (the ROS_DOMAIN_ID)")->capture_default_str();
   cmd->add_option("--name", o->name, "Node name (default: the task)");
@@ -131,6 +132,7 @@ void addNodeCommand(CLI::App& app) {
     run.topic = o->topic;
     run.calibration = o->calibration;
     run.topic_domain = o->domain;
+    run.ground_truth = o->ground_truth;
     run.no_loop_closing = o->no_loop_closing;
     run.network.enabled = true;
     run.network.domain = o->domain;

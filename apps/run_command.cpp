@@ -44,6 +44,7 @@ RunSummary runSlam(const RunOptions& o) {
   if (!o.config.empty()) dataset_options.settings = o.config;
   if (!o.times.empty()) dataset_options.times = o.times;
   std::unique_ptr<io::FrameSource> source;
+  if (o.dataset.empty() == o.topic.empty()) throw InputError("give a DATASET or a --topic (one of them)");
   if (o.topic.empty()) {
     source = io::openDataset(o.dataset, dataset_options);
   } else {
@@ -216,9 +217,14 @@ RunSummary runSlam(const RunOptions& o) {
                        {"points_culled", ms.points_culled}, {"keyframes_culled", ms.keyframes_culled},
                        {"local_bas", ms.local_bas}, {"local_bas_discarded", ms.local_bas_discarded}};
   std::string ate_line = "no ground truth";
-  if (source->groundTruth() && estimate.size() >= 3) {
+  std::optional<io::Trajectory> truth = source->groundTruth();
+  if (!o.ground_truth.empty()) {
+    truth = io::openDataset(o.ground_truth)->groundTruth();
+    if (!truth) throw InputError(o.ground_truth + " has no ground truth");
+  }
+  if (truth && estimate.size() >= 3) {
     try {
-      const auto ate = eval::computeAte(*source->groundTruth(), estimate);
+      const auto ate = eval::computeAte(*truth, estimate);
       report["ate"] = eval::toJson(ate.stats);
       report["ate"]["path_length"] = ate.reference_length;
       report["ate"]["percent_of_path"] = 100.0 * ate.stats.rmse / std::max(ate.reference_length, 1e-9);
@@ -246,7 +252,11 @@ RunSummary runSlam(const RunOptions& o) {
 void addRunCommand(CLI::App& app) {
   auto* cmd = app.add_subcommand("run", "Run standalone monocular SLAM on a dataset");
   auto o = std::make_shared<RunOptions>();
-  cmd->add_option("DATASET", o->dataset, "EuRoC/TUM-VI folder, TUM RGB-D folder, image folder or video")->required();
+  cmd->add_option("DATASET", o->dataset, "EuRoC/TUM-VI folder, TUM RGB-D folder, image folder or video");
+  cmd->add_option("--topic", o->topic, "Instead of a DATASET: a ROS 2 sensor_msgs/msg/Image topic (e.g. /camera/image_raw)");
+  cmd->add_option("--calibration", o->calibration, "With --topic: camera file (settings YAML, sensor.yaml or calib.txt)");
+  cmd->add_option("--domain", o->topic_domain, "With --topic: DDS domain id (the ROS_DOMAIN_ID)")->capture_default_str();
+  cmd->add_option("--ground-truth", o->ground_truth, "Score against this dataset's ground truth (for --topic)");
   cmd->add_option("--config", o->config, "Settings YAML (camera section)");
   cmd->add_option("--times", o->times, "Times file for image folders and videos");
   cmd->add_option("--out", o->out, "Output folder")->required();

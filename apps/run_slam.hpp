@@ -21,6 +21,8 @@ struct RunOptions {
   std::string topic, calibration;
   int topic_domain = 0;
   int topic_wait_seconds = 30;  // for the first image
+  // A dataset whose ground truth scores the run (for a topic, which carries none).
+  std::string ground_truth;
   // As the TR node of a distributed system (hiveslam node --task tr): on a DDS domain, waiting
   // for the peers it expects before the first frame.
   struct Network {

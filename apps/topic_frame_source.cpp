@@ -33,13 +33,16 @@ cv::Mat toGray(const communication::CameraImage& image) {
 
 TopicFrameSource::TopicFrameSource(int domain, const std::string& ros_topic, io::CameraSettings camera,
                                    std::chrono::milliseconds first_wait, std::chrono::milliseconds idle)
-    : topic_(ros_topic), domain_(domain), reader_(domain, ros_topic), camera_(std::move(camera)),
-      first_wait_(first_wait), idle_(idle) {}
+    : topic_(ros_topic), domain_(domain), camera_(std::move(camera)), first_wait_(first_wait), idle_(idle) {
+  communication::ddsTopicName(ros_topic);  // a bad name is refused now, not at the first frame
+  if (domain < 0 || domain > 232) throw InputError("DDS domain must be 0-232");
+}
 
 std::optional<io::Frame> TopicFrameSource::next() {
   io::Frame f;
+  if (!reader_) reader_ = std::make_unique<communication::ImageTopicReader>(domain_, topic_);
   while (f.image.empty()) {
-    auto image = reader_.next(first_wait_, idle_);
+    auto image = reader_->next(first_wait_, idle_);
     if (!image) return std::nullopt;
     f.index = index_++;
     f.timestamp = static_cast<double>(image->stamp_ns) * 1e-9;

@@ -24,12 +24,14 @@ class TopicFrameSource final : public io::FrameSource {
   const io::CameraSettings& camera() const override { return camera_; }
   const std::optional<io::Trajectory>& groundTruth() const override { return no_truth_; }
   std::string describe() const override;
-  uint64_t dropped() const { return reader_.dropped(); }
+  uint64_t dropped() const { return reader_ ? reader_->dropped() : 0; }
 
  private:
   std::string topic_;
   int domain_;
-  communication::ImageTopicReader reader_;
+  // Made by the first next(): a node that first waits for its peers does not take images it
+  // cannot track yet (they would be dropped as stale).
+  std::unique_ptr<communication::ImageTopicReader> reader_;
   io::CameraSettings camera_;
   std::chrono::milliseconds first_wait_, idle_;
   std::optional<io::Trajectory> no_truth_;
