@@ -241,12 +241,11 @@ void DistributedNode::onGlobal(std::vector<MapRecord>&& batches, Topic topic) {
 void DistributedNode::onControl(const Message& m, Topic topic) {
   const auto c = static_cast<Control>(m.target);
   if (c == Control::EndOfSequence) {
-    {
-      std::lock_guard lock(mutex_);
-      run_hosted_ = plan_.hosted;
-    }
-    // Runs off the subscriber thread: finishing waits for queues that thread may feed.
-    if (finisher_.joinable()) return;
+    // Runs off the subscriber thread: finishing waits for queues that thread may feed. Made
+    // under the lock: stop() takes the thread from another thread.
+    std::lock_guard lock(mutex_);
+    run_hosted_ = plan_.hosted;
+    if (finisher_.joinable() || stopping_) return;
     if (options_.task == Task::LoopClosing) {
       finisher_ = std::thread([this] {
         slam_.drain();
@@ -316,7 +315,13 @@ bool DistributedNode::waitUntilDone(std::chrono::milliseconds timeout) {
 }
 
 void DistributedNode::stop() {
-  if (finisher_.joinable()) finisher_.join();
+  std::thread finisher;
+  {
+    std::lock_guard lock(mutex_);
+    stopping_ = true;
+    finisher = std::move(finisher_);
+  }
+  if (finisher.joinable()) finisher.join();
   publisher_->finish();
   transport_.stop();
   subscriber_->finish();

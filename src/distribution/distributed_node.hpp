@@ -89,10 +89,11 @@ class DistributedNode final : public core::SystemEvents {
   std::map<core::Id, uint64_t> published_;  // LC: last global epoch published, per map
   std::set<core::Id> outstanding_;          // TR: keyframes sent, not yet in a local map
   bool done_ = false, lc_done_ = false;
+  bool stopping_ = false;  // stop() has begun: no finisher may start any more
   uint8_t run_hosted_ = 0;  // what it ran when the sequence ended (before peers leave)
   int globals_ignored_ = 0;
   uint64_t incarnation_ = 0;
-  std::thread finisher_;
+  std::thread finisher_;  // the end-of-run exchange (LM, LC)
 };
 
 }  // namespace hiveslam::distribution
