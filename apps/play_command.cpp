@@ -3,7 +3,9 @@
 // the TR node's trajectory can be scored against the dataset's ground truth afterwards.
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <thread>
 
 #include "apps/commands.hpp"

@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cstdlib>
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -109,6 +110,29 @@ TEST(NodeProcesses, ATrackingNodeNeedsOneInputAndACalibration) {
   EXPECT_NE(std::system((bin + " node --task tr --topic '/bad name' --calibration " + calibration + " --out " +
                          out.path().string() + " 2>/dev/null").c_str()), 0);
 }
+// A node that dies mid-run: TR notices the LM's lease expire, takes local mapping back (the
+// policy with LC present and no LM) and finishes the sequence with its own map copy.
+TEST(NodeProcesses, TrackingTakesMappingBackWhenTheMappingNodeDies) {
+  testing::TempDir out;
+  const std::string bin = HIVESLAM_BINARY, domain = " --domain " + std::to_string(150 + getpid() % 50);
+  const std::string run =
+      bin + " node --task lm" + domain + " --out " + (out / "lm").string() + " > " + (out / "lm.log").string() +
+      " 2>&1 & lm=$!; " + bin + " node --task lc" + domain + " --out " + (out / "lc").string() + " > " +
+      (out / "lc.log").string() + " 2>&1 & lc=$!; " + bin + " node --task tr " + sequence().string() + domain +
+      " --expect lm,lc --realtime --out " + (out / "tr").string() + " > " + (out / "tr.log").string() +
+      " 2>&1 & tr=$!; sleep 6; kill -9 $lm; wait $tr; status=$?; kill $lc; wait; exit $status";
+  const int status = std::system(("timeout 300 bash -c '" + run + "'").c_str());
+  ASSERT_EQ(status, 0) << std::ifstream(out / "tr.log").rdbuf();
+  const auto tr = report(out / "tr" / "report.json");
+  const auto hosted = tasks(tr);
+  EXPECT_NE(std::find(hosted.begin(), hosted.end(), "lm"), hosted.end()) << tr.dump();
+  // The take-over costs frames today (measured: 84% tracked, one tracking failure, ~30
+  // frames dropped on a 500-frame loop; docs/BENCHMARKS.md): the bound says the run goes on.
+  EXPECT_GT(tr.value("tracked_frames", 0), 150);
+  EXPECT_LT(tr["ate"]["percent_of_path"].get<double>(), 1.0);
+  EXPECT_GT(tr["mapping"]["keyframes_processed"].get<int>(), 0);  // it mapped after the LM left
+}
+
 TEST(NodeProcesses, ThreeNodesInThreeNetworkNamespaces) {
   if (geteuid() != 0) GTEST_SKIP() << "network namespaces need root";
   const std::string tag = std::to_string(getpid() % 100000);
