@@ -53,6 +53,12 @@ RunSummary runSlam(const RunOptions& o) {
     source = std::make_unique<TopicFrameSource>(o.topic_domain, o.topic, io::loadCameraFile(calibration),
                                                 std::chrono::seconds(o.topic_wait_seconds), std::chrono::seconds(3));
   }
+  // Checked before the run, not after it: a wrong path must not cost the run its report.
+  std::optional<io::Trajectory> truth = source->groundTruth();
+  if (!o.ground_truth.empty()) {
+    truth = io::openDataset(o.ground_truth)->groundTruth();
+    if (!truth) throw InputError(o.ground_truth + " has no ground truth");
+  }
   // A live topic paces itself; a dataset is paced here in real-time mode.
   const bool pace = o.realtime && o.topic.empty();
   const std::filesystem::path out(o.out);
@@ -217,11 +223,6 @@ RunSummary runSlam(const RunOptions& o) {
                        {"points_culled", ms.points_culled}, {"keyframes_culled", ms.keyframes_culled},
                        {"local_bas", ms.local_bas}, {"local_bas_discarded", ms.local_bas_discarded}};
   std::string ate_line = "no ground truth";
-  std::optional<io::Trajectory> truth = source->groundTruth();
-  if (!o.ground_truth.empty()) {
-    truth = io::openDataset(o.ground_truth)->groundTruth();
-    if (!truth) throw InputError(o.ground_truth + " has no ground truth");
-  }
   if (truth && estimate.size() >= 3) {
     try {
       const auto ate = eval::computeAte(*truth, estimate);
