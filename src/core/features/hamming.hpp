@@ -1,10 +1,18 @@
 #pragma once
 // Hamming distance of two 256-bit descriptors (32-byte rows), by popcount on 64-bit words.
-#include <bit>
 #include <cstdint>
 #include <cstring>
 
 namespace hiveslam::features {
+
+// Bit count of a 64-bit word by the parallel (SWAR) method, inline: baseline x86-64 has no
+// popcount instruction, and std::popcount there is a library call per word.
+inline int popcount64(uint64_t v) {
+  v = v - ((v >> 1) & 0x5555555555555555ULL);
+  v = (v & 0x3333333333333333ULL) + ((v >> 2) & 0x3333333333333333ULL);
+  v = (v + (v >> 4)) & 0x0f0f0f0f0f0f0f0fULL;
+  return static_cast<int>((v * 0x0101010101010101ULL) >> 56);
+}
 
 inline int hamming(const unsigned char* a, const unsigned char* b) {
   int d = 0;
@@ -12,7 +20,7 @@ inline int hamming(const unsigned char* a, const unsigned char* b) {
     uint64_t x, y;
     std::memcpy(&x, a + 8 * i, 8);
     std::memcpy(&y, b + 8 * i, 8);
-    d += std::popcount(x ^ y);
+    d += popcount64(x ^ y);
   }
   return d;
 }

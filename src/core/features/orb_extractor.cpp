@@ -4,6 +4,7 @@
 #include <array>
 #include <cmath>
 #include <opencv2/features2d.hpp>
+#include <opencv2/core/hal/intrin.hpp>
 #include <opencv2/imgproc.hpp>
 #include <queue>
 
@@ -41,7 +42,8 @@ std::vector<cv::KeyPoint> distribute(const std::vector<cv::KeyPoint>& kps, const
     else if (!n.idx.empty()) open.push(std::move(n));
   }
   while (!open.empty() && static_cast<int>(open.size() + done.size()) < target) {
-    Node n = open.top();
+    // Moved out, not copied: pop() moves the top to the back unread before it sifts.
+    Node n = std::move(const_cast<Node&>(open.top()));
     open.pop();
     const float hw = n.rect.width / 2, hh = n.rect.height / 2;
     if (hw < 1.0f && hh < 1.0f) {  // cannot split further: points on one pixel
@@ -61,7 +63,7 @@ std::vector<cv::KeyPoint> distribute(const std::vector<cv::KeyPoint>& kps, const
     }
   }
   while (!open.empty()) {
-    done.push_back(open.top());
+    done.push_back(std::move(const_cast<Node&>(open.top())));
     open.pop();
   }
   std::vector<cv::KeyPoint> out;
@@ -104,19 +106,48 @@ float orientation(const cv::Mat& img, cv::Point2f pt) {
   return a < 0 ? a + 360.0f : a;
 }
 
-// The 256 tests of the rotated pattern, pixels read by their offset from the centre.
+// The pattern's 512 points as floats, x and y apart, for four-at-a-time rotation.
+struct PatternPoints {
+  alignas(16) std::array<float, 512> x, y;
+};
+const PatternPoints& patternPoints() {
+  static const PatternPoints pts = [] {
+    PatternPoints p;
+    const auto& pattern = briefPattern();
+    for (size_t t = 0; t < 256; ++t) {
+      p.x[2 * t] = static_cast<float>(pattern[t][0]);
+      p.y[2 * t] = static_cast<float>(pattern[t][1]);
+      p.x[2 * t + 1] = static_cast<float>(pattern[t][2]);
+      p.y[2 * t + 1] = static_cast<float>(pattern[t][3]);
+    }
+    return p;
+  }();
+  return pts;
+}
+
+// The 256 tests of the rotated pattern, pixels read by their offset from the centre. The
+// offsets are rotated four at a time with the same float operations and round-to-nearest as
+// the one-at-a-time form (row cvRound(s x + c y), column cvRound(c x - s y)): bit-identical
+// descriptors, which the vocabulary and every peer rely on.
 void describe(const cv::Mat& smooth, const cv::KeyPoint& kp, cv::Point2f at, uchar* out) {
-  const auto& pattern = briefPattern();
+  const PatternPoints& pts = patternPoints();
   const float a = kp.angle * static_cast<float>(CV_PI / 180.0);
   const float c = std::cos(a), s = std::sin(a);
   const uchar* centre = smooth.ptr<uchar>(cvRound(at.y)) + cvRound(at.x);
   const int step = static_cast<int>(smooth.step1());
-  auto offset = [&](int x, int y) { return cvRound(s * x + c * y) * step + cvRound(c * x - s * y); };
-  for (int byte = 0; byte < 32; ++byte) {
+  alignas(16) std::array<int, 512> offset;
+  const cv::v_float32x4 vc = cv::v_setall_f32(c), vs = cv::v_setall_f32(s);
+  const cv::v_int32x4 vstep = cv::v_setall_s32(step);
+  for (size_t j = 0; j < 512; j += 4) {
+    const cv::v_float32x4 x = cv::v_load_aligned(&pts.x[j]), y = cv::v_load_aligned(&pts.y[j]);
+    const cv::v_int32x4 row = cv::v_round(vs * x + vc * y), col = cv::v_round(vc * x - vs * y);
+    cv::v_store_aligned(&offset[j], row * vstep + col);
+  }
+  for (size_t byte = 0; byte < 32; ++byte) {
     uchar v = 0;
-    for (int bit = 0; bit < 8; ++bit) {
-      const auto& p = pattern[static_cast<size_t>(byte * 8 + bit)];
-      if (centre[offset(p[0], p[1])] < centre[offset(p[2], p[3])]) v |= static_cast<uchar>(1u << bit);
+    for (size_t bit = 0; bit < 8; ++bit) {
+      const size_t t = 2 * (byte * 8 + bit);
+      if (centre[offset[t]] < centre[offset[t + 1]]) v |= static_cast<uchar>(1u << bit);
     }
     out[byte] = v;
   }
@@ -140,26 +171,67 @@ OrbExtractor::OrbExtractor(const OrbOptions& o) : options_(o) {
   per_level_.push_back(std::max(o.features - sum, 0));
 }
 
+namespace {
+
+// Per-thread buffers reused from frame to frame: a frame allocates nothing big (the level
+// images alone are 1.5 MB, and fresh allocations that size are fresh pages, zeroed by the
+// kernel each frame).
+struct Scratch {
+  std::vector<cv::Mat> padded, smooth;
+  std::vector<cv::KeyPoint> found, fast;
+  std::vector<int> per_cell, first_pass;
+};
+
+// Fills the kBorder-wide frame of `padded` around its interior by BORDER_REFLECT_101, in place
+// (what copyMakeBorder does, without copying the interior).
+void reflectBorder(cv::Mat& padded) {
+  const int W = padded.cols - 2 * kBorder, H = padded.rows - 2 * kBorder;
+  for (int y = kBorder; y < kBorder + H; ++y) {
+    uchar* row = padded.ptr<uchar>(y);
+    for (int i = 1; i <= kBorder; ++i) {
+      row[kBorder - i] = row[kBorder + i];
+      row[kBorder + W - 1 + i] = row[kBorder + W - 1 - i];
+    }
+  }
+  for (int i = 1; i <= kBorder; ++i) {
+    padded.row(kBorder + i).copyTo(padded.row(kBorder - i));
+    padded.row(kBorder + H - 1 - i).copyTo(padded.row(kBorder + H - 1 + i));
+  }
+}
+
+}  // namespace
+
 void OrbExtractor::extract(const cv::Mat& gray, std::vector<cv::KeyPoint>& keypoints, cv::Mat& descriptors) const {
   CV_Assert(gray.type() == CV_8UC1);
   keypoints.clear();
-  std::vector<cv::Mat> descs;
-  cv::Mat level_img = gray;
+  thread_local Scratch scratch;
+  const size_t levels = static_cast<size_t>(options_.levels);
+  if (scratch.padded.size() < levels) {
+    scratch.padded.resize(levels);
+    scratch.smooth.resize(levels);
+  }
+  cv::Mat all_desc(options_.features + 64, 32, CV_8U);
+  int n_desc = 0;
   for (int level = 0; level < options_.levels; ++level) {
     const double s = scales_[static_cast<size_t>(level)];
-    if (level > 0) {
-      const cv::Size size(cvRound(gray.cols / s), cvRound(gray.rows / s));
-      if (size.width < 2 * kBorder || size.height < 2 * kBorder) break;
-      cv::resize(gray, level_img, size, 0, 0, cv::INTER_LINEAR);
-    }
-    cv::Mat padded;
-    cv::copyMakeBorder(level_img, padded, kBorder, kBorder, kBorder, kBorder, cv::BORDER_REFLECT_101);
+    const cv::Size size = level == 0 ? gray.size() : cv::Size(cvRound(gray.cols / s), cvRound(gray.rows / s));
+    if (size.width < 2 * kBorder || size.height < 2 * kBorder) break;
+    cv::Mat& padded = scratch.padded[static_cast<size_t>(level)];
+    padded.create(size.height + 2 * kBorder, size.width + 2 * kBorder, CV_8U);
+    cv::Mat level_img = padded(cv::Rect(kBorder, kBorder, size.width, size.height));
+    if (level == 0) gray.copyTo(level_img);
+    else cv::resize(gray, level_img, size, 0, 0, cv::INTER_LINEAR);
+    reflectBorder(padded);
+    const double sx = static_cast<double>(gray.cols) / level_img.cols;
+    const double sy = static_cast<double>(gray.rows) / level_img.rows;
     // FAST over the whole level at the first threshold (one call, no per-cell overhead), then
     // again at the lower threshold in the cells where it found nothing: the adaptive threshold.
-    std::vector<cv::KeyPoint> found;
+    std::vector<cv::KeyPoint>& found = scratch.found;
+    found.clear();
     const int W = level_img.cols, H = level_img.rows, cs = options_.cell_size;
     const int cols = (W + cs - 1) / cs, rows = (H + cs - 1) / cs;
-    std::vector<int> per_cell(static_cast<size_t>(cols * rows), 0);
+    std::vector<int>& per_cell = scratch.per_cell;
+    per_cell.assign(static_cast<size_t>(cols * rows), 0);
     auto keep = [&](cv::KeyPoint kp, float dx, float dy) {
       kp.pt.x += dx;
       kp.pt.y += dy;
@@ -167,20 +239,19 @@ void OrbExtractor::extract(const cv::Mat& gray, std::vector<cv::KeyPoint>& keypo
       ++per_cell[static_cast<size_t>(static_cast<int>(kp.pt.y) / cs * cols + static_cast<int>(kp.pt.x) / cs)];
       found.push_back(kp);
     };
+    std::vector<cv::KeyPoint>& k = scratch.fast;
     {
       // 3 px margin for the FAST circle, taken from the reflected border.
       const cv::Rect all(kBorder - 3, kBorder - 3, W + 6, H + 6);
-      std::vector<cv::KeyPoint> k;
       cv::FAST(padded(all), k, options_.fast_threshold, true);
       for (const auto& kp : k) keep(kp, -3.0f, -3.0f);
     }
-    const std::vector<int> first_pass = per_cell;
+    scratch.first_pass = per_cell;
     for (int cy = 0; cy < rows; ++cy)
       for (int cx = 0; cx < cols; ++cx) {
-        if (first_pass[static_cast<size_t>(cy * cols + cx)] > 0) continue;
+        if (scratch.first_pass[static_cast<size_t>(cy * cols + cx)] > 0) continue;
         const int x0 = cx * cs, y0 = cy * cs;
         const cv::Rect cell(x0 + kBorder - 3, y0 + kBorder - 3, std::min(cs, W - x0) + 6, std::min(cs, H - y0) + 6);
-        std::vector<cv::KeyPoint> k;
         cv::FAST(padded(cell), k, options_.min_fast_threshold, true);
         for (const auto& kp : k) {
           // Only corners inside this cell: its neighbours already have their own.
@@ -191,25 +262,31 @@ void OrbExtractor::extract(const cv::Mat& gray, std::vector<cv::KeyPoint>& keypo
       }
     std::vector<cv::KeyPoint> kept = distribute(found, cv::Rect2f(0, 0, static_cast<float>(W), static_cast<float>(H)),
                                                 per_level_[static_cast<size_t>(level)]);
-    cv::Mat smooth;
+    cv::Mat& smooth = scratch.smooth[static_cast<size_t>(level)];
     cv::GaussianBlur(padded, smooth, cv::Size(7, 7), 2, 2, cv::BORDER_REFLECT_101);
-    cv::Mat level_desc(static_cast<int>(kept.size()), 32, CV_8U);
+    if (n_desc + static_cast<int>(kept.size()) > all_desc.rows) {
+      cv::Mat bigger(n_desc + static_cast<int>(kept.size()), 32, CV_8U);
+      all_desc.rowRange(0, n_desc).copyTo(bigger.rowRange(0, n_desc));
+      all_desc = bigger;
+    }
     for (size_t i = 0; i < kept.size(); ++i) {
       cv::KeyPoint& kp = kept[i];
       const cv::Point2f at(kp.pt.x + kBorder, kp.pt.y + kBorder);
       kp.angle = orientation(padded, at);
-      describe(smooth, kp, at, level_desc.ptr<uchar>(static_cast<int>(i)));
+      describe(smooth, kp, at, all_desc.ptr<uchar>(n_desc++));
       kp.octave = level;
       kp.size = static_cast<float>(31.0 * s);
-      // resize maps pixel centres: level pixel x sits at (x + 0.5) s - 0.5 on level 0.
-      kp.pt.x = static_cast<float>((kp.pt.x + 0.5) * s - 0.5);
-      kp.pt.y = static_cast<float>((kp.pt.y + 0.5) * s - 0.5);
+      // resize maps pixel centres: level pixel x sits at (x + 0.5) sx - 0.5 on level 0, with
+      // the level's true ratio sx = width0 / width (rounded sizes make it differ from s by up
+      // to 0.3%: 0.4 px at the image edge, a zoom that differs per level and reads as motion
+      // along the optical axis when a point changes level between views).
+      kp.pt.x = static_cast<float>((kp.pt.x + 0.5) * sx - 0.5);
+      kp.pt.y = static_cast<float>((kp.pt.y + 0.5) * sy - 0.5);
       keypoints.push_back(kp);
     }
-    if (!kept.empty()) descs.push_back(level_desc);
   }
-  if (descs.empty()) descriptors.release();
-  else cv::vconcat(descs, descriptors);
+  if (n_desc == 0) descriptors.release();
+  else descriptors = all_desc.rowRange(0, n_desc).clone();  // never into a buffer the caller shares
 }
 
 }  // namespace hiveslam::features

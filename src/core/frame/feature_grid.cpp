@@ -11,11 +11,18 @@ FeatureGrid::FeatureGrid(const std::vector<Eigen::Vector2d>& points, double min_
       min_y_(min_y),
       inv_w_(kCols / std::max(max_x - min_x, 1.0)),
       inv_h_(kRows / std::max(max_y - min_y, 1.0)),
-      cells_(static_cast<size_t>(kCols * kRows)) {
-  for (int i = 0; i < static_cast<int>(points.size()); ++i) {
-    const auto& p = points[static_cast<size_t>(i)];
-    cells_[static_cast<size_t>(cellY(p.y()) * kCols + cellX(p.x()))].push_back(i);
+      start_(static_cast<size_t>(kCols * kRows + 1), 0),
+      index_(points.size()) {
+  // Counting sort by cell: a stable grouping, so each cell lists its points in index order.
+  std::vector<int> cell_of(points.size());
+  for (size_t i = 0; i < points.size(); ++i) {
+    cell_of[i] = cellY(points[i].y()) * kCols + cellX(points[i].x());
+    ++start_[static_cast<size_t>(cell_of[i]) + 1];
   }
+  for (size_t c = 1; c < start_.size(); ++c) start_[c] += start_[c - 1];
+  std::vector<int> fill(start_.begin(), start_.end() - 1);
+  for (size_t i = 0; i < points.size(); ++i)
+    index_[static_cast<size_t>(fill[static_cast<size_t>(cell_of[i])]++)] = static_cast<int>(i);
 }
 
 int FeatureGrid::cellX(double x) const { return std::clamp(static_cast<int>(std::floor((x - min_x_) * inv_w_)), 0, kCols - 1); }
@@ -24,15 +31,7 @@ int FeatureGrid::cellY(double y) const { return std::clamp(static_cast<int>(std:
 std::vector<int> FeatureGrid::inRadius(const std::vector<Eigen::Vector2d>& points, double x, double y,
                                        double radius) const {
   std::vector<int> out;
-  if (cells_.empty()) return out;
-  const int x0 = cellX(x - radius), x1 = cellX(x + radius), y0 = cellY(y - radius), y1 = cellY(y + radius);
-  const double r2 = radius * radius;
-  for (int cy = y0; cy <= y1; ++cy)
-    for (int cx = x0; cx <= x1; ++cx)
-      for (int i : cells_[static_cast<size_t>(cy * kCols + cx)]) {
-        const auto& p = points[static_cast<size_t>(i)];
-        if ((p.x() - x) * (p.x() - x) + (p.y() - y) * (p.y() - y) <= r2) out.push_back(i);
-      }
+  forEachInRadius(points, x, y, radius, [&](int i) { out.push_back(i); });
   return out;
 }
 

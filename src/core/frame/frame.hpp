@@ -38,6 +38,10 @@ struct Frame {
   void buildGrid();
   static constexpr double kFarOutside = -1e6;  // where a keypoint with no pinhole image goes
   std::vector<int> inRadius(double x, double y, double r) const { return grid.inRadius(points, x, y, r); }
+  template <class F>
+  void forEachInRadius(double x, double y, double r, F&& f) const {
+    grid.forEachInRadius(points, x, y, r, std::forward<F>(f));
+  }
 };
 
 // Extracts and undistorts the features of one grey image.

@@ -16,12 +16,12 @@ std::vector<int> matchForInitialization(const Frame& f1, const Frame& f2, const 
     const auto& kp = f1.keypoints[i];
     const auto& p = around ? (*around)[i] : f1.points[i];
     features::NearestTwo near;
-    for (int j : f2.inRadius(p.x(), p.y(), o.radius)) {
-      if (f2.keypoints[static_cast<size_t>(j)].octave != kp.octave) continue;
+    f2.forEachInRadius(p.x(), p.y(), o.radius, [&](int j) {
+      if (f2.keypoints[static_cast<size_t>(j)].octave != kp.octave) return;
       const int d = features::hamming(f1.descriptors.ptr<uchar>(static_cast<int>(i)), f2.descriptors.ptr<uchar>(j));
-      if (d > dist21[static_cast<size_t>(j)]) continue;  // f2's keypoint already has a closer match
+      if (d > dist21[static_cast<size_t>(j)]) return;  // f2's keypoint already has a closer match
       near.offer(d, j);
-    }
+    });
     if (!near.accepted(o.max_distance, o.ratio)) continue;
     const int best = near.best;
     const size_t j = static_cast<size_t>(near.index);

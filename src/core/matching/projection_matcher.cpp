@@ -10,15 +10,15 @@ namespace hiveslam::core {
 int bestNear(const Frame& frame, const Eigen::Vector2d& uv, double radius, int min_level, int max_level,
              const unsigned char* descriptor, int max_distance, int* distance) {
   int best = std::numeric_limits<int>::max(), best_i = -1;
-  for (int i : frame.inRadius(uv.x(), uv.y(), radius)) {
+  frame.forEachInRadius(uv.x(), uv.y(), radius, [&](int i) {
     const int level = frame.keypoints[static_cast<size_t>(i)].octave;
-    if (level < min_level || level > max_level) continue;
+    if (level < min_level || level > max_level) return;
     const int d = features::hamming(descriptor, frame.descriptors.ptr<uchar>(i));
     if (d < best) {
       best = d;
       best_i = i;
     }
-  }
+  });
   if (best > max_distance) return -1;
   if (distance) *distance = best;
   return best_i;
