@@ -65,7 +65,7 @@ void serve(const NodeCommandOptions& o, communication::Task task) {
   report["end_of_run"] = done ? "completed" : "interrupted";
   report["mapping"] = {{"keyframes_processed", ms.keyframes_processed}, {"points_created", ms.points_created},
                        {"keyframes_culled", ms.keyframes_culled}, {"local_bas", ms.local_bas},
-                       {"local_bas_discarded", ms.local_bas_discarded}};
+                       {"local_bas_discarded", ms.local_bas_discarded}, {"local_bas_cut_short", ms.local_bas_cut_short}};
   report["loop_closing"] = settings.loop_closing;
   report["loops"] = ls.loops;
   report["merges"] = ls.merges;

@@ -221,7 +221,7 @@ RunSummary runSlam(const RunOptions& o) {
   const auto& ms = slam.mappingStats();
   report["mapping"] = {{"keyframes_processed", ms.keyframes_processed}, {"points_created", ms.points_created},
                        {"points_culled", ms.points_culled}, {"keyframes_culled", ms.keyframes_culled},
-                       {"local_bas", ms.local_bas}, {"local_bas_discarded", ms.local_bas_discarded}};
+                       {"local_bas", ms.local_bas}, {"local_bas_discarded", ms.local_bas_discarded}, {"local_bas_cut_short", ms.local_bas_cut_short}};
   std::string ate_line = "no ground truth";
   if (truth && estimate.size() >= 3) {
     try {

@@ -42,6 +42,7 @@ void LocalMapper::process(const std::shared_ptr<Map>& map, const std::shared_ptr
     o.iterations = settings_.local_ba_iterations;
     o.abort = abort_ba;
     ba.summary = bundleAdjust(ba.problem, o);
+    if (ba.summary.aborted) ++stats_.local_bas_cut_short;
     lock.lock();
     applyLocalBa(*map, ba);
   }

@@ -15,6 +15,7 @@ namespace hiveslam::core {
 struct MappingStats {
   int keyframes_processed = 0, points_created = 0, points_culled = 0, keyframes_culled = 0, local_bas = 0,
       local_bas_discarded = 0;
+  int local_bas_cut_short = 0;  // stopped early because a newer keyframe was waiting
 };
 
 class LocalMapper {

@@ -73,6 +73,7 @@ BaSummary bundleAdjust(BaProblem& pb, const BaOptions& o) {
   classify();
   // Second round without the outliers: even under a robust kernel they pull the solution.
   const bool aborted = o.abort && o.abort->load();
+  out.aborted = aborted;
   int removed = 0;
   for (size_t i = 0; i < blocks.size() && !aborted && o.outlier_round; ++i)
     if (out.outlier[i] && problem.NumResidualBlocks() > 1) {

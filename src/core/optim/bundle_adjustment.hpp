@@ -44,6 +44,7 @@ struct BaOptions {
 
 struct BaSummary {
   bool converged = false;
+  bool aborted = false;  // cut short by BaOptions::abort
   int iterations = 0;
   double initial_cost = 0, final_cost = 0;
   std::vector<bool> outlier;  // per observation: chi-square above 5.991 after optimizing
