@@ -48,8 +48,17 @@ DistributedNode::DistributedNode(core::SlamSystem& slam, communication::Transpor
   MapHandler::Hooks hooks;
   hooks.stale = [this](const MapRecord& m) {
     std::lock_guard lock(mutex_);
-    auto it = published_.find(m.map);
-    return it != published_.end() && m.epoch < it->second;
+    return m.epoch < knownEpoch(m.map);
+  };
+  hooks.hold = [this](const MapRecord& m) {
+    std::lock_guard lock(mutex_);
+    if (m.epoch <= knownEpoch(m.map)) return false;
+    // Bounded: a global update that never comes (its sender died) costs old poses, not memory.
+    constexpr size_t kMaxHeld = 256;
+    if (held_.size() >= kMaxHeld) held_.erase(held_.begin());
+    held_.push_back(m);
+    ++local_maps_held_;
+    return true;
   };
   hooks.global = [this](std::vector<MapRecord>&& b, Topic t) { onGlobal(std::move(b), t); };
   hooks.epoch = [this](core::Id map) {
@@ -213,9 +222,12 @@ void DistributedNode::onGlobal(std::vector<MapRecord>&& batches, Topic topic) {
     std::vector<core::Id> merged;
     for (const auto& b : batches) merged.insert(merged.end(), b.merged_maps.begin(), b.merged_maps.end());
     auto map = slam_.findMap(map_id);
-    std::lock_guard lock(mutex_);
-    synced_[map_id] = std::max(synced_[map_id], epoch);
-    if (map) handler_->sendGlobal(map, epoch, Topic::LmMap, merged);
+    {
+      std::lock_guard lock(mutex_);
+      synced_[map_id] = std::max(synced_[map_id], epoch);
+      if (map) handler_->sendGlobal(map, epoch, Topic::LmMap, merged);
+    }
+    releaseHeld(map_id);
     return;
   }
   bool ignore = false;
@@ -234,8 +246,36 @@ void DistributedNode::onGlobal(std::vector<MapRecord>&& batches, Topic topic) {
     return;
   }
   integrator_.applyGlobal(batches, true);
-  std::lock_guard lock(mutex_);
-  synced_[map_id] = std::max(synced_[map_id], epoch);
+  {
+    std::lock_guard lock(mutex_);
+    synced_[map_id] = std::max(synced_[map_id], epoch);
+  }
+  releaseHeld(map_id);
+}
+
+uint64_t DistributedNode::knownEpoch(core::Id map) const {
+  uint64_t e = 0;
+  if (auto it = synced_.find(map); it != synced_.end()) e = it->second;
+  if (auto it = published_.find(map); it != published_.end()) e = std::max(e, it->second);
+  return e;
+}
+
+void DistributedNode::releaseHeld(core::Id map) {
+  // Runs on the map handler's thread, like every other apply: arrival order is kept.
+  std::vector<std::pair<MapRecord, bool>> ready;  // (local map, stale)
+  {
+    std::lock_guard lock(mutex_);
+    const uint64_t now = knownEpoch(map);
+    for (auto it = held_.begin(); it != held_.end();) {
+      if (it->map == map && it->epoch <= now) {
+        ready.emplace_back(std::move(*it), it->epoch < now);
+        it = held_.erase(it);
+      } else {
+        ++it;
+      }
+    }
+  }
+  for (const auto& [m, stale] : ready) integrator_.applyLocal(m, stale);
 }
 
 void DistributedNode::onControl(const Message& m, Topic topic) {
@@ -382,6 +422,7 @@ nlohmann::json DistributedNode::report(double seconds) const {
   {
     std::lock_guard lock(mutex_);
     j["globals_ignored"] = globals_ignored_;
+    j["local_maps_held"] = local_maps_held_;
     j["peers"] = peers_.size();
   }
   j["s_full_keyframes"] = observer_.keyframeCount();

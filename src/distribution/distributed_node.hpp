@@ -88,11 +88,15 @@ class DistributedNode final : public core::SystemEvents {
   std::map<core::Id, uint64_t> synced_;     // last global epoch applied, per map
   std::map<core::Id, uint64_t> published_;  // LC: last global epoch published, per map
   std::set<core::Id> outstanding_;          // TR: keyframes sent, not yet in a local map
+  std::vector<MapRecord> held_;             // local maps ahead of synced_, in arrival order
   bool done_ = false, lc_done_ = false;
   bool stopping_ = false;  // stop() has begun: no finisher may start any more
   uint8_t run_hosted_ = 0;  // what it ran when the sequence ended (before peers leave)
   int globals_ignored_ = 0;
+  int local_maps_held_ = 0;  // local maps that came ahead of their global update
   uint64_t incarnation_ = 0;
+  uint64_t knownEpoch(core::Id map) const;  // the newer of synced_ and published_; mutex_ held
+  void releaseHeld(core::Id map);           // applies the held local maps the epoch has reached
   std::thread finisher_;  // the end-of-run exchange (LM, LC)
 };
 

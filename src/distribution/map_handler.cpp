@@ -331,6 +331,10 @@ void MapHandler::handleIncoming(communication::Message& msg, Topic topic) {
     MapRecord m = decodeMap(unpack(msg, PacketKind::Map));
     ++received_;
     if (m.kind == MapRecord::Kind::Local) {
+      if (hooks_.hold && hooks_.hold(m)) {
+        if (hooks_.local_applied) hooks_.local_applied(m);
+        return;
+      }
       integrator_.applyLocal(m, hooks_.stale && hooks_.stale(m));
       if (hooks_.local_applied) hooks_.local_applied(m);
     } else if (auto all = observer_.collectGlobal(std::move(m))) {

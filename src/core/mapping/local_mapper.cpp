@@ -126,7 +126,7 @@ void LocalMapper::triangulateNewPoints(Map& map, KeyFrame& kf) {
       const size_t j = static_cast<size_t>(best_j);
       const double s1 = scales_[static_cast<size_t>(kf.frame.keypoints[i].octave)];
       const double s2 = scales_[static_cast<size_t>(nb->frame.keypoints[j].octave)];
-      TriangulationCheck check{std::sqrt(5.991) * std::max(s1, s2), 0.9998};
+      TriangulationCheck check{std::sqrt(5.991) * std::max(s1, s2), settings_.triangulation_max_cos_parallax};
       const auto X1 = triangulate(K.ray(kf.frame.points[i]), K.ray(nb->frame.points[j]), T21, f, check);
       if (!X1) continue;
       const Eigen::Vector3d Xw = T1w.inverse() * *X1;

@@ -30,6 +30,7 @@ struct SlamSettings {
   int lost_frames_before_new_map = 20;
   // Local mapping
   int triangulation_neighbours = 10;
+  double triangulation_max_cos_parallax = 0.9998;  // new points need a wider angle (1.15 deg)
   int fusion_neighbours = 10;
   int local_ba_iterations = 10;
   double redundant_keyframe_ratio = 0.9;
