@@ -28,11 +28,4 @@ FeatureGrid::FeatureGrid(const std::vector<Eigen::Vector2d>& points, double min_
 int FeatureGrid::cellX(double x) const { return std::clamp(static_cast<int>(std::floor((x - min_x_) * inv_w_)), 0, kCols - 1); }
 int FeatureGrid::cellY(double y) const { return std::clamp(static_cast<int>(std::floor((y - min_y_) * inv_h_)), 0, kRows - 1); }
 
-std::vector<int> FeatureGrid::inRadius(const std::vector<Eigen::Vector2d>& points, double x, double y,
-                                       double radius) const {
-  std::vector<int> out;
-  forEachInRadius(points, x, y, radius, [&](int i) { out.push_back(i); });
-  return out;
-}
-
 }  // namespace hiveslam::core

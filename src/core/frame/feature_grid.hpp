@@ -32,7 +32,6 @@ class FeatureGrid {
         }
       }
   }
-  std::vector<int> inRadius(const std::vector<Eigen::Vector2d>& points, double x, double y, double radius) const;
 
  private:
   static constexpr int kCols = 64, kRows = 48;

@@ -37,7 +37,7 @@ struct Frame {
   // Builds the grid over `points` (after extraction, or after loading a saved keyframe).
   void buildGrid();
   static constexpr double kFarOutside = -1e6;  // where a keypoint with no pinhole image goes
-  std::vector<int> inRadius(double x, double y, double r) const { return grid.inRadius(points, x, y, r); }
+  // f(i) for each keypoint i whose undistorted point lies within r pixels of (x, y).
   template <class F>
   void forEachInRadius(double x, double y, double r, F&& f) const {
     grid.forEachInRadius(points, x, y, r, std::forward<F>(f));
