@@ -45,6 +45,7 @@ TEST(ImageTopic, ImagesArriveIntactAndTheStreamEndsWithItsWriter) {
   {
     ImageTopicWriter writer(domain, "/test/image");
     ASSERT_TRUE(writer.waitForReaders(1, 5s));
+    ASSERT_TRUE(reader.waitForWriter(5s));
     for (int k = 0; k < 3; ++k) {
       writer.write(image(10 * (k + 1), 1'000'000'000LL * (k + 1) + 5));
       std::this_thread::sleep_for(20ms);
@@ -70,6 +71,7 @@ TEST(ImageTopic, ASlowReaderKeepsTheNewestImages) {
   ImageTopicReader reader(domain, "/test/burst", 2);
   ImageTopicWriter writer(domain, "/test/burst");
   ASSERT_TRUE(writer.waitForReaders(1, 5s));
+  ASSERT_TRUE(reader.waitForWriter(5s));
   for (int k = 0; k < 6; ++k) {
     writer.write(image(k, k + 1));
     std::this_thread::sleep_for(10ms);

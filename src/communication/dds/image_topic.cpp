@@ -204,6 +204,12 @@ std::optional<CameraImage> ImageTopicReader::next(std::chrono::milliseconds firs
   return image;
 }
 
+bool ImageTopicReader::waitForWriter(std::chrono::milliseconds timeout) {
+  Impl& d = *impl_;
+  std::unique_lock lock(d.mutex);
+  return d.arrived.wait_for(lock, timeout, [&] { return d.writers_now > 0; });
+}
+
 uint64_t ImageTopicReader::dropped() const {
   std::lock_guard lock(impl_->mutex);
   return impl_->dropped;

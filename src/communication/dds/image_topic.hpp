@@ -58,6 +58,10 @@ class ImageTopicReader {
   std::optional<CameraImage> next(std::chrono::milliseconds first, std::chrono::milliseconds idle);
   // Images dropped because the reader was behind.
   uint64_t dropped() const;
+  // Whether a writer has matched within `timeout`. Discovery is not symmetric: a writer can
+  // see this reader before this reader sees it, and best-effort images it sends meanwhile are
+  // lost (harmless in a stream; a test that counts images waits for both sides).
+  bool waitForWriter(std::chrono::milliseconds timeout);
 
  private:
   struct Impl;
