@@ -6,6 +6,7 @@
 #include <opencv2/features2d.hpp>
 #include <opencv2/core/hal/intrin.hpp>
 #include <opencv2/imgproc.hpp>
+#include <numeric>
 #include <queue>
 
 #include "core/features/brief_pattern.hpp"
@@ -210,7 +211,9 @@ void OrbExtractor::extract(const cv::Mat& gray, std::vector<cv::KeyPoint>& keypo
     scratch.padded.resize(levels);
     scratch.smooth.resize(levels);
   }
-  cv::Mat all_desc(options_.features + 64, 32, CV_8U);
+  // One descriptor block per frame, filled level by level: each level keeps at most its
+  // per_level_ share. Fresh every call, so the rows handed out share memory with nothing.
+  cv::Mat all_desc(std::max(std::accumulate(per_level_.begin(), per_level_.end(), 0), 1), 32, CV_8U);
   int n_desc = 0;
   for (int level = 0; level < options_.levels; ++level) {
     const double s = scales_[static_cast<size_t>(level)];
@@ -264,11 +267,7 @@ void OrbExtractor::extract(const cv::Mat& gray, std::vector<cv::KeyPoint>& keypo
                                                 per_level_[static_cast<size_t>(level)]);
     cv::Mat& smooth = scratch.smooth[static_cast<size_t>(level)];
     cv::GaussianBlur(padded, smooth, cv::Size(7, 7), 2, 2, cv::BORDER_REFLECT_101);
-    if (n_desc + static_cast<int>(kept.size()) > all_desc.rows) {
-      cv::Mat bigger(n_desc + static_cast<int>(kept.size()), 32, CV_8U);
-      all_desc.rowRange(0, n_desc).copyTo(bigger.rowRange(0, n_desc));
-      all_desc = bigger;
-    }
+    CV_Assert(n_desc + static_cast<int>(kept.size()) <= all_desc.rows);
     for (size_t i = 0; i < kept.size(); ++i) {
       cv::KeyPoint& kp = kept[i];
       const cv::Point2f at(kp.pt.x + kBorder, kp.pt.y + kBorder);
@@ -286,7 +285,7 @@ void OrbExtractor::extract(const cv::Mat& gray, std::vector<cv::KeyPoint>& keypo
     }
   }
   if (n_desc == 0) descriptors.release();
-  else descriptors = all_desc.rowRange(0, n_desc).clone();  // never into a buffer the caller shares
+  else descriptors = all_desc.rowRange(0, n_desc);
 }
 
 }  // namespace hiveslam::features
