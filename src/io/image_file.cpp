@@ -1,6 +1,8 @@
 #include "io/image_file.hpp"
 
 #include <cstring>
+#include <optional>
+#include <stdexcept>
 #include <fstream>
 #include <algorithm>
 #include <opencv2/imgcodecs.hpp>
@@ -8,6 +10,7 @@
 #include <vector>
 
 #include "common/error.hpp"
+#include "io/png_gray_decoder.hpp"
 
 namespace hiveslam::io {
 
@@ -43,6 +46,13 @@ cv::Mat readGrayImage(const std::filesystem::path& path) {
   if (bytes.empty()) throw InputError("image file is empty: " + path.string());
   if ((isPng(bytes) && !pngComplete(bytes)) || (isJpeg(bytes) && !jpegComplete(bytes)))
     throw InputError("image file is truncated: " + path.string());
+  if (isPng(bytes)) {
+    try {
+      if (std::optional<cv::Mat> gray = decodeGrayPng(bytes.data(), bytes.size())) return *gray;
+    } catch (const std::runtime_error& e) {
+      throw InputError("cannot decode image " + path.string() + ": " + e.what());
+    }
+  }
   cv::Mat image;
   try {
     image = cv::imdecode(bytes, cv::IMREAD_UNCHANGED);
