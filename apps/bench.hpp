@@ -19,7 +19,7 @@ struct BenchRow {
   std::string sequence;
   int nodes = 1;
   std::vector<double> ate, ate_percent, fails, tracked, cpu_seconds, cpu_percent, bw_tr, bw_lm, bw_lc, kf_hz, map_hz,
-      loops;
+      loops, maps;
   nlohmann::json toJson() const;
 };
 

@@ -22,6 +22,37 @@ size_t linksHash(const KeyFrameRecord& r) {
   return h;
 }
 
+// Appends what `into` lacks, in order (a replacement chain a->b, b->c must stay in order).
+template <typename T>
+void appendNew(const std::vector<T>& from, std::vector<T>& into) {
+  std::set<T> have(into.begin(), into.end());
+  for (const T& x : from)
+    if (have.insert(x).second) into.push_back(x);
+}
+
+// Moves the map's journal of erasures into `m` (after what `m` carries already). An id that is
+// alive again (erased, then brought back by an update from a node that had not heard of the
+// erasure yet) is left out: the record's own points and keyframes say it exists, and a
+// receiver applying both would drop it while the sender keeps it. The caller holds the map's
+// mutex.
+void takeJournal(core::Map& map, MapRecord& m) {
+  appendNew(map.journal.erased_keyframes, m.erased_keyframes);
+  appendNew(map.journal.erased_points, m.erased_points);
+  appendNew(map.journal.replaced_points, m.replaced_points);
+  map.journal = {};
+  auto alivePoint = [&](core::Id id) {
+    auto it = map.points.find(id);
+    return it != map.points.end() && !it->second->bad;
+  };
+  auto aliveKeyframe = [&](core::Id id) {
+    auto it = map.keyframes.find(id);
+    return it != map.keyframes.end() && !it->second->bad;
+  };
+  std::erase_if(m.erased_points, alivePoint);
+  std::erase_if(m.erased_keyframes, aliveKeyframe);
+  std::erase_if(m.replaced_points, [&](const auto& r) { return alivePoint(r.first); });
+}
+
 }  // namespace
 
 MapHandler::MapHandler(communication::Transport& transport, StateIntegrator& integrator, Observer& observer,
@@ -96,18 +127,23 @@ void MapHandler::sendGlobal(const std::shared_ptr<core::Map>& map, uint64_t epoc
                             std::vector<core::Id> merged_maps, bool full) {
   {
     std::lock_guard lock(mutex_);
-    // A newer global update of the map replaces one not yet (fully) sent.
-    for (auto it = globals_.begin(); it != globals_.end();)
-      if (it->map == map && it->topic == topic && it != globals_.begin())
-        it = globals_.erase(it);
-      else
-        ++it;
+    // A newer global update of the map replaces one not yet (fully) sent. What that one
+    // announced once (the maps it merged, the map's erasures) goes with the newer one: a
+    // receiver drops an update it did not get whole, and one that never hears of a merge keeps
+    // the merged map apart, one that never hears of an erasure keeps the point.
     GlobalJob g;
     g.map = map;
     g.epoch = epoch;
     g.topic = topic;
     g.merged = std::move(merged_maps);
     g.full = full;
+    for (auto it = globals_.begin(); it != globals_.end();)
+      if (it->map == map && it->topic == topic && it != globals_.begin()) {
+        carryOver(*it, g);
+        it = globals_.erase(it);
+      } else {
+        ++it;
+      }
     globals_.push_back(std::move(g));
   }
   wake_.notify_all();
@@ -150,9 +186,12 @@ void MapHandler::loop() {
       }
       lock.lock();
       // Unfinished: it goes back to the front unless a newer update of the map came meanwhile.
-      const bool superseded = std::any_of(globals_.begin(), globals_.end(),
-                                          [&](const GlobalJob& o) { return o.map == g.map && o.topic == g.topic; });
-      if (g.next < g.batches.size() && !superseded) globals_.push_front(std::move(g));
+      auto newer = std::find_if(globals_.begin(), globals_.end(),
+                                [&](const GlobalJob& o) { return o.map == g.map && o.topic == g.topic; });
+      if (g.next < g.batches.size()) {
+        if (newer == globals_.end()) globals_.push_front(std::move(g));
+        else carryOver(g, *newer);
+      }
       next_global = Clock::now() + std::chrono::milliseconds(settings_.global_batch_gap_ms);
       continue;
     }
@@ -238,10 +277,7 @@ void MapHandler::sendLocalBatch(Outgoing& o) {
         if (p && !p->bad && unsent.erase(p->id)) m.points.push_back(capturePoint(*p, true));
     }
     o.dirty_points = std::move(unsent);
-    m.erased_keyframes = std::move(map.journal.erased_keyframes);
-    m.erased_points = std::move(map.journal.erased_points);
-    m.replaced_points = std::move(map.journal.replaced_points);
-    map.journal = {};
+    takeJournal(map, m);
   }
   if (m.keyframes.empty() && m.points.empty() && m.erased_keyframes.empty() && m.erased_points.empty() &&
       m.replaced_points.empty())
@@ -273,6 +309,17 @@ void MapHandler::trimForSending(MapRecord& m, Topic topic, bool full) {
     if (k.links) sent[k.id] = linksHash(k);
 }
 
+void MapHandler::carryOver(GlobalJob& from, GlobalJob& into) {
+  appendNew(from.merged, into.merged);
+  into.full = into.full || from.full;  // a snapshot for a newcomer stays one
+  // Erasures ride with the first batch; a job replaced after its capture took them from the
+  // map's journal already.
+  const MapRecord& once = from.batches.empty() ? from.carried : from.batches.front();
+  appendNew(once.erased_keyframes, into.carried.erased_keyframes);
+  appendNew(once.erased_points, into.carried.erased_points);
+  appendNew(once.replaced_points, into.carried.replaced_points);
+}
+
 void MapHandler::captureGlobal(GlobalJob& g) {
   core::Map& map = *g.map;
   std::vector<KeyFrameRecord> kfs;
@@ -292,10 +339,10 @@ void MapHandler::captureGlobal(GlobalJob& g) {
     for (const core::KeyFrame* k : sorted) kfs.push_back(captureKeyframe(*k, map.id, false));
     for (const auto& [id, p] : map.points)
       if (!p->bad) points.push_back(capturePoint(*p, true));
-    base.erased_keyframes = std::move(map.journal.erased_keyframes);
-    base.erased_points = std::move(map.journal.erased_points);
-    base.replaced_points = std::move(map.journal.replaced_points);
-    map.journal = {};
+    base.erased_keyframes = std::move(g.carried.erased_keyframes);
+    base.erased_points = std::move(g.carried.erased_points);
+    base.replaced_points = std::move(g.carried.replaced_points);
+    takeJournal(map, base);
   }
   std::sort(points.begin(), points.end(), [](const auto& a, const auto& b) { return a.id < b.id; });
   const size_t per = static_cast<size_t>(std::max(settings_.global_batch, 1));

@@ -77,7 +77,10 @@ class MapHandler {
     bool full = false;
     std::vector<MapRecord> batches;  // captured when its turn comes
     size_t next = 0;
+    MapRecord carried;  // erasures of the updates this one replaced
   };
+  // `from` is replaced by the newer `into`: what `from` would have announced once moves over.
+  static void carryOver(GlobalJob& from, GlobalJob& into);
   void loop();
   void handleIncoming(communication::Message& m, communication::Topic topic);
   void sendLocalBatch(Outgoing& o);

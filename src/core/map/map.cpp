@@ -8,18 +8,25 @@ void Map::observe(KeyFrame& kf, int index, const std::shared_ptr<MapPoint>& p) {
 }
 
 void Map::erase(MapPoint& p) {
+  // Only a point of this map: a module still holding a point of a map merged into another (or
+  // already erased) must not mark it bad there while it stays listed and linked.
+  auto it = points.find(p.id);
+  if (it == points.end() || it->second.get() != &p) return;
   p.bad = true;
   for (const auto& [kf, idx] : p.observations) kf->points[static_cast<size_t>(idx)].reset();
   p.observations.clear();
-  if (auto it = points.find(p.id); it != points.end()) {
-    erased_points.push_back(it->second);
-    points.erase(it);
-    if (journal_on) journal.erased_points.push_back(p.id);
-  }
+  erased_points.push_back(it->second);
+  points.erase(it);
+  if (journal_on) journal.erased_points.push_back(p.id);
 }
 
 void Map::replace(MapPoint& old, const std::shared_ptr<MapPoint>& by) {
   if (&old == by.get()) return;
+  auto mine = [&](const MapPoint& p) {
+    auto it = points.find(p.id);
+    return it != points.end() && it->second.get() == &p;
+  };
+  if (!mine(old) || !mine(*by)) return;
   for (const auto& [kf, idx] : old.observations) {
     if (by->observations.count(kf)) {
       kf->points[static_cast<size_t>(idx)].reset();  // already sees `by` at another keypoint
@@ -31,11 +38,10 @@ void Map::replace(MapPoint& old, const std::shared_ptr<MapPoint>& by) {
   by->found += old.found;
   old.observations.clear();
   old.bad = true;
-  if (auto it = points.find(old.id); it != points.end()) {
-    erased_points.push_back(it->second);
-    points.erase(it);
-    if (journal_on) journal.replaced_points.emplace_back(old.id, by->id);
-  }
+  auto it = points.find(old.id);
+  erased_points.push_back(it->second);
+  points.erase(it);
+  if (journal_on) journal.replaced_points.emplace_back(old.id, by->id);
 }
 
 void Map::absorb(Map& other) {
@@ -53,6 +59,8 @@ void Map::absorb(Map& other) {
 
 void Map::erase(KeyFrame& kf) {
   if (&kf == origin) return;  // the origin anchors the map's coordinate frame
+  auto it = keyframes.find(kf.id);
+  if (it == keyframes.end() || it->second.get() != &kf) return;  // not (or no longer) this map's
   if (kf.parent) kf.T_c_parent = kf.T_cw * kf.parent->pose().inverse();
   kf.bad = true;
   for (auto& p : kf.points)
@@ -70,11 +78,9 @@ void Map::erase(KeyFrame& kf) {
   }
   if (kf.parent) kf.parent->children.erase(&kf);
   kf.children.clear();
-  if (auto it = keyframes.find(kf.id); it != keyframes.end()) {
-    retired.push_back(it->second);
-    keyframes.erase(it);
-    if (journal_on) journal.erased_keyframes.push_back(kf.id);
-  }
+  retired.push_back(it->second);
+  keyframes.erase(it);
+  if (journal_on) journal.erased_keyframes.push_back(kf.id);
 }
 
 }  // namespace hiveslam::core

@@ -56,7 +56,9 @@ class Map {
   void add(const std::shared_ptr<MapPoint>& p) { points[p->id] = p; }
   // Adds the observation both ways.
   static void observe(KeyFrame& kf, int index, const std::shared_ptr<MapPoint>& p);
-  // Removes a point from every keyframe that sees it and from the map.
+  // Removes a point from every keyframe that sees it and from the map. These three act only on
+  // objects listed in this map (a no-op otherwise: a point of a map merged meanwhile lives on in
+  // the other map and must stay whole there).
   void erase(MapPoint& p);
   // Replaces `old` by `by` in every observation (duplicate fusion).
   void replace(MapPoint& old, const std::shared_ptr<MapPoint>& by);

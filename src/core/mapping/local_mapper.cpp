@@ -30,6 +30,9 @@ struct LocalMapper::LocalBa {
 void LocalMapper::process(const std::shared_ptr<Map>& map, const std::shared_ptr<KeyFrame>& kf,
                           const std::atomic<bool>* abort_ba) {
   std::unique_lock lock(map->mutex);
+  // Merged into another map since the job was queued: the keyframe is in the old frame and
+  // the map is empty (SlamSystem drops such jobs; this closes the gap until the lock).
+  if (map->merged_into.load()) return;
   map->collectGarbage();
   insert(*map, *kf);
   cullRecentPoints(*map, *kf);
@@ -45,6 +48,7 @@ void LocalMapper::process(const std::shared_ptr<Map>& map, const std::shared_ptr
     if (ba.summary.aborted) ++stats_.local_bas_cut_short;
     lock.lock();
     applyLocalBa(*map, ba);
+    if (map->merged_into.load()) return;  // merged during the BA: its keyframes live elsewhere
   }
   cullKeyframes(*map, *kf);
   ++stats_.keyframes_processed;
