@@ -63,6 +63,17 @@ void Observer::prune(const std::unordered_set<Id>& keyframes, const std::unorder
     }
 }
 
+bool Observer::erasedPoint(Id id) const {
+  std::lock_guard lock(mutex_);
+  return erased_points_.count(id) > 0;
+}
+
+void Observer::revive(const MapRecord& snapshot) {
+  std::lock_guard lock(mutex_);
+  for (const auto& k : snapshot.keyframes) erased_keyframes_.erase(k.id);
+  for (const auto& p : snapshot.points) erased_points_.erase(p.id);
+}
+
 void Observer::erasePoint(Id id) {
   std::lock_guard lock(mutex_);
   points_.erase(id);

@@ -31,6 +31,11 @@ class Observer {
   void prune(const std::unordered_set<Id>& keyframes, const std::unordered_set<Id>& points,
              const std::function<bool(Id)>& known_to_sender);
   void erasePoint(Id id);
+  // Whether the point was erased here (a tombstone: a record from a node that has not heard of
+  // the erasure yet must not bring it back).
+  bool erasedPoint(Id id) const;
+  // An authoritative snapshot lists these as alive: their tombstones go before it is recorded.
+  void revive(const MapRecord& snapshot);
   // A global map's batches until the last one is in; returns all batches then.
   std::optional<std::vector<MapRecord>> collectGlobal(MapRecord&& batch);
   bool hasPoint(Id id) const;

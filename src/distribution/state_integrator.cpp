@@ -37,7 +37,7 @@ std::shared_ptr<core::Map> StateIntegrator::mapFor(Id id) {
   return m;
 }
 
-void StateIntegrator::applyPoint(core::Map& map, const PointRecord& r) {
+void StateIntegrator::applyPoint(core::Map& map, const PointRecord& r, bool authoritative) {
   auto it = map.points.find(r.id);
   std::shared_ptr<core::MapPoint> p;
   if (it != map.points.end()) {
@@ -45,6 +45,9 @@ void StateIntegrator::applyPoint(core::Map& map, const PointRecord& r) {
     p->position = r.position;
   } else {
     if (!r.full) return;  // its full record is on the way (or it was erased meanwhile)
+    // Erased here; the sender had not heard of it yet. Brought back, it would live on as a
+    // duplicate of the point that replaced it, and only here.
+    if (!authoritative && observer_.erasedPoint(r.id)) return;
     p = std::make_shared<core::MapPoint>(r.id, r.position, r.first_keyframe);
     map.add(p);
   }
@@ -194,6 +197,8 @@ void StateIntegrator::applyLocal(const MapRecord& m, bool stale) {
 
 void StateIntegrator::applyGlobal(const std::vector<MapRecord>& batches, bool authoritative) {
   if (batches.empty()) return;
+  if (authoritative)
+    for (const auto& b : batches) observer_.revive(b);
   for (const auto& b : batches) observer_.record(b);
   auto map = slam_.findMap(batches.front().map);
   if (!map || map->merged_into.load()) return;
@@ -225,7 +230,7 @@ void StateIntegrator::applyGlobal(const std::vector<MapRecord>& batches, bool au
   }
   core::applyCorrection(*map, c, slam_.scales());
   for (const auto& b : batches)
-    for (const auto& p : b.points) applyPoint(*map, p);
+    for (const auto& p : b.points) applyPoint(*map, p, authoritative);
   for (const auto& b : batches)
     for (const auto& k : b.keyframes)
       if (auto it = map->keyframes.find(k.id); it != map->keyframes.end()) {

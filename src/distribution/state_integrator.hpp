@@ -32,7 +32,8 @@ class StateIntegrator {
 
  private:
   std::shared_ptr<core::Map> mapFor(Id id);
-  void applyPoint(core::Map& map, const PointRecord& r);
+  // `authoritative`: the record may bring back a point erased here (see Observer::erasedPoint).
+  void applyPoint(core::Map& map, const PointRecord& r, bool authoritative = false);
   void relink(core::Map& map, core::KeyFrame& kf, const KeyFrameRecord& r);
   void applyErasures(core::Map& map, const MapRecord& m);
   std::shared_ptr<core::KeyFrame> makeKeyframe(const KeyFrameRecord& r) const;
