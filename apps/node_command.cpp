@@ -70,6 +70,7 @@ void serve(const NodeCommandOptions& o, communication::Task task) {
   report["loops"] = ls.loops;
   report["merges"] = ls.merges;
   report["global_bas"] = ls.global_bas;
+  report["loop_events"] = loopEventsJson(ls);
   size_t kfs = 0, points = 0;
   report["map_keyframes"] = nlohmann::json::array();
   for (const auto& m : slam.liveMaps()) {

@@ -28,6 +28,18 @@
 
 namespace hiveslam::apps {
 
+nlohmann::json loopEventsJson(const core::LoopStats& stats) {
+  nlohmann::json events = nlohmann::json::array();
+  for (const auto& e : stats.events)
+    events.push_back({{"kind", e.kind == core::LoopEvent::Kind::Loop ? "loop" : "merge"},
+                      {"timestamp", e.timestamp},
+                      {"matches", e.matches},
+                      {"scale", e.scale},
+                      {"correct_ms", e.correct_ms},
+                      {"essential_graph_ms", e.essential_graph_ms}});
+  return events;
+}
+
 namespace {
 
 double percentile(std::vector<double> v, double q) {
@@ -189,14 +201,8 @@ RunSummary runSlam(const RunOptions& o) {
   report["merges"] = ls.merges;
   report["global_bas"] = ls.global_bas;
   std::vector<eval::PlotEvent> plot_events;
-  report["loop_events"] = nlohmann::json::array();
-  for (const auto& e : ls.events) {
-    const char* kind = e.kind == core::LoopEvent::Kind::Loop ? "loop" : "merge";
-    report["loop_events"].push_back({{"kind", kind}, {"timestamp", e.timestamp}, {"matches", e.matches},
-                                     {"scale", e.scale}, {"correct_ms", e.correct_ms},
-                                     {"essential_graph_ms", e.essential_graph_ms}});
-    plot_events.push_back({e.timestamp, kind});
-  }
+  report["loop_events"] = loopEventsJson(ls);
+  for (const auto& e : ls.events) plot_events.push_back({e.timestamp, e.kind == core::LoopEvent::Kind::Loop ? "loop" : "merge"});
   report["loop_timing"] = {{"keyframes_checked", ls.keyframes_checked},
                            {"query_ms_mean", ls.query_ms_total / std::max(ls.keyframes_checked, 1)},
                            {"rejected_geometry", ls.rejected_geometry},

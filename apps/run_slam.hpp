@@ -2,6 +2,8 @@
 // The standalone SLAM run behind `hiveslam run` (and the demo): dataset in, trajectory files,
 // report.json and plot out.
 #include <nlohmann/json.hpp>
+
+#include "core/loop/loop_closer.hpp"
 #include <string>
 #include <vector>
 
@@ -34,6 +36,10 @@ struct RunOptions {
     int wait_seconds = 20;
   } network;
 };
+
+// Each loop closure and merge as a report entry: kind, timestamp of the keyframe that
+// recognized the place, matches, the Sim3's scale (the drift seen), timings.
+nlohmann::json loopEventsJson(const core::LoopStats& stats);
 
 struct RunSummary {
   nlohmann::json report;  // what report.json holds
