@@ -171,29 +171,11 @@ void StateIntegrator::applyLocal(const MapRecord& m, bool stale) {
   if (!map || map->merged_into.load()) return;
   std::lock_guard lock(map->mutex);
   if (stale) {
-    // The record's positions are in the sender's older frame. A new point comes over through a
-    // keyframe that sees it in the record and that this map holds: its position relative to
-    // that keyframe is kept (added where the sender had it, a point made before a loop
-    // correction sat off the corrected map by the loop's drift, and LC then "closed" the loop
-    // again on it, with Sim3 scales like 0.84 and 1.58). Points without such a keyframe wait
-    // for a full record in the frame of this node.
-    std::unordered_map<Id, Eigen::Isometry3d> via;  // point -> T_new^-1 T_old
-    for (const auto& k : m.keyframes) {
-      auto it = map->keyframes.find(k.id);
-      if (it == map->keyframes.end() || !k.links) continue;
-      const Eigen::Isometry3d T = it->second->T_cw.inverse() * k.T_cw;
-      for (const auto& [i, pid] : k.matches) via.emplace(pid, T);
-    }
-    for (const auto& p : m.points) {
-      if (map->points.count(p.id)) continue;
-      auto v = via.find(p.id);
-      if (v == via.end()) continue;
-      PointRecord moved = p;
-      moved.position = v->second * p.position;
-      moved.normal = v->second.linear() * p.normal;
-      applyPoint(*map, moved);
-      observer_.record(moved);
-    }
+    for (const auto& p : m.points)
+      if (!map->points.count(p.id)) {
+        applyPoint(*map, p);
+        observer_.record(p);
+      }
     applyErasures(*map, m);
     for (Id id : m.erased_keyframes) observer_.eraseKeyframe(id);
     for (Id id : m.erased_points) observer_.erasePoint(id);
