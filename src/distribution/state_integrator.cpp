@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cstring>
+#include <set>
 #include <unordered_set>
 
 #include "core/loop/map_correction.hpp"
@@ -60,8 +61,9 @@ void StateIntegrator::applyPoint(core::Map& map, const PointRecord& r, bool auth
   }
 }
 
-void StateIntegrator::relink(core::Map& map, core::KeyFrame& kf, const KeyFrameRecord& r) {
-  if (!r.links) return;
+bool StateIntegrator::relink(core::Map& map, core::KeyFrame& kf, const KeyFrameRecord& r) {
+  if (!r.links) return false;
+  bool changed = false;
   std::vector<std::shared_ptr<core::MapPoint>> want(kf.points.size());
   for (const auto& [i, pid] : r.matches) {
     if (i >= want.size()) continue;
@@ -70,6 +72,7 @@ void StateIntegrator::relink(core::Map& map, core::KeyFrame& kf, const KeyFrameR
   for (size_t i = 0; i < want.size(); ++i) {
     auto& have = kf.points[i];
     if (have == want[i]) continue;
+    changed = true;
     if (have) {
       have->observations.erase(&kf);
       have.reset();
@@ -77,6 +80,7 @@ void StateIntegrator::relink(core::Map& map, core::KeyFrame& kf, const KeyFrameR
   }
   for (size_t i = 0; i < want.size(); ++i) {
     if (!want[i] || kf.points[i] == want[i]) continue;
+    changed = true;
     // The point may still be linked at another keypoint of this keyframe (not in the record).
     if (auto o = want[i]->observations.find(&kf); o != want[i]->observations.end())
       kf.points[static_cast<size_t>(o->second)].reset();
@@ -94,6 +98,7 @@ void StateIntegrator::relink(core::Map& map, core::KeyFrame& kf, const KeyFrameR
       kf.loop_edges.insert(it->second.get());
       it->second->loop_edges.insert(&kf);
     }
+  return changed;
 }
 
 void StateIntegrator::applyErasures(core::Map& map, const MapRecord& m) {
@@ -184,15 +189,28 @@ void StateIntegrator::applyLocal(const MapRecord& m, bool stale) {
   }
   observer_.record(m);
   for (const auto& p : m.points) applyPoint(*map, p);
+  // Covisibility is rebuilt only where links changed: most of a window's keyframes come with a
+  // new pose and the same points, and rebuilding them all was most of this node's map
+  // handling at TR.
+  std::set<core::KeyFrame*, core::ById> relinked;  // by id: the rebuild order is the same on every node
   for (const auto& k : m.keyframes) {
     auto it = map->keyframes.find(k.id);
     if (it == map->keyframes.end()) continue;
     it->second->T_cw = k.T_cw;
-    relink(*map, *it->second, k);
+    if (relink(*map, *it->second, k)) relinked.insert(it->second.get());
   }
+  const auto observers = [&](Id point) {
+    if (auto it = map->points.find(point); it != map->points.end())
+      for (const auto& [kf, i] : it->second->observations) relinked.insert(kf);
+  };
+  for (const auto& [old, by] : m.replaced_points) {
+    observers(old);
+    observers(by);
+  }
+  for (Id id : m.erased_points) observers(id);
   applyErasures(*map, m);
-  for (const auto& k : m.keyframes)
-    if (auto it = map->keyframes.find(k.id); it != map->keyframes.end()) it->second->updateConnections();
+  for (core::KeyFrame* kf : relinked)
+    if (!kf->bad) kf->updateConnections();
 }
 
 void StateIntegrator::applyGlobal(const std::vector<MapRecord>& batches, bool authoritative) {

@@ -34,7 +34,8 @@ class StateIntegrator {
   std::shared_ptr<core::Map> mapFor(Id id);
   // `authoritative`: the record may bring back a point erased here (see Observer::erasedPoint).
   void applyPoint(core::Map& map, const PointRecord& r, bool authoritative = false);
-  void relink(core::Map& map, core::KeyFrame& kf, const KeyFrameRecord& r);
+  // True when the keyframe's point links changed.
+  bool relink(core::Map& map, core::KeyFrame& kf, const KeyFrameRecord& r);
   void applyErasures(core::Map& map, const MapRecord& m);
   std::shared_ptr<core::KeyFrame> makeKeyframe(const KeyFrameRecord& r) const;
   core::SlamSystem& slam_;

@@ -2,6 +2,7 @@
 
 #include <opencv2/imgproc.hpp>
 
+#include "core/features/brief_pattern.hpp"
 #include "core/features/hamming.hpp"
 #include "core/features/orb_extractor.hpp"
 #include "synth/sequence.hpp"
@@ -16,12 +17,19 @@ cv::Mat renderedImage() {
   return model.renderImage(150, synth::RayTable(model.lens));
 }
 
+struct Extracted {
+  std::vector<cv::KeyPoint> keypoints;
+  cv::Mat descriptors;
+};
+Extracted extractDefault(const cv::Mat& img) {
+  Extracted e;
+  OrbExtractor().extract(img, e.keypoints, e.descriptors);
+  return e;
+}
+
 TEST(OrbExtractor, FindsTheRequestedNumberSpreadOverTheImage) {
   const cv::Mat img = renderedImage();
-  OrbExtractor orb;
-  std::vector<cv::KeyPoint> kps;
-  cv::Mat desc;
-  orb.extract(img, kps, desc);
+  const auto [kps, desc] = extractDefault(img);
   EXPECT_GE(kps.size(), 900u);
   EXPECT_LE(kps.size(), 1000u);
   EXPECT_EQ(desc.rows, static_cast<int>(kps.size()));
@@ -80,6 +88,36 @@ TEST(OrbExtractor, DescriptorsAndAnglesFollowImageRotation) {
   ASSERT_GT(tested, 200);
   EXPECT_GT(static_cast<double>(correct) / tested, 0.45) << correct << "/" << tested;
   EXPECT_GT(static_cast<double>(angle_ok) / std::max(correct, 1), 0.85);
+}
+
+// Level-0 descriptors against the definition, one test at a time in plain code: the rotated
+// pattern over the 7x7 (sigma 2) smoothed image, bit t of the descriptor set when the first
+// point of pair t is darker. The vocabulary and every peer rely on these exact bits.
+TEST(OrbExtractor, DescriptorsAreTheRotatedBriefTestsBitForBit) {
+  const cv::Mat img = renderedImage();
+  const auto [kps, desc] = extractDefault(img);
+  cv::Mat padded, smooth;
+  cv::copyMakeBorder(img, padded, 19, 19, 19, 19, cv::BORDER_REFLECT_101);
+  cv::GaussianBlur(padded, smooth, cv::Size(7, 7), 2, 2, cv::BORDER_REFLECT_101);
+  int checked = 0;
+  for (size_t i = 0; i < kps.size(); ++i) {
+    if (kps[i].octave != 0) continue;
+    const float a = kps[i].angle * static_cast<float>(CV_PI / 180.0);
+    const float c = std::cos(a), s = std::sin(a);
+    const int cx = cvRound(kps[i].pt.x) + 19, cy = cvRound(kps[i].pt.y) + 19;
+    const auto& pattern = briefPattern();
+    for (size_t t = 0; t < 256; ++t) {
+      const auto at = [&](int x, int y) {
+        const float fx = static_cast<float>(x), fy = static_cast<float>(y);
+        return smooth.at<uchar>(cy + cvRound(s * fx + c * fy), cx + cvRound(c * fx - s * fy));
+      };
+      const bool bit = at(pattern[t][0], pattern[t][1]) < at(pattern[t][2], pattern[t][3]);
+      const bool got = (desc.at<uchar>(static_cast<int>(i), static_cast<int>(t / 8)) >> (t % 8)) & 1;
+      ASSERT_EQ(got, bit) << "keypoint " << i << " test " << t;
+    }
+    ++checked;
+  }
+  EXPECT_GT(checked, 100);
 }
 
 TEST(OrbExtractor, DeterministicAndCheapOnBlankImages) {

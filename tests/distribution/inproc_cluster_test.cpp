@@ -27,13 +27,18 @@ void expectSameState(const StateDigest& a, const StateDigest& b, const char* wha
   EXPECT_EQ(a.points.size(), b.points.size()) << what;
   int missing = 0;
   double worst = 0;
+  std::string worst_what;  // which object, for the failure message
   for (const auto& [id, T] : a.keyframes) {
     auto it = b.keyframes.find(id);
     if (it == b.keyframes.end()) {
       ++missing;
       continue;
     }
-    worst = std::max(worst, (T.inverse().translation() - it->second.inverse().translation()).norm());
+    const double d = (T.inverse().translation() - it->second.inverse().translation()).norm();
+    if (d > worst) {
+      worst = d;
+      worst_what = "keyframe " + std::to_string(id);
+    }
   }
   for (const auto& [id, p] : a.points) {
     auto it = b.points.find(id);
@@ -41,10 +46,14 @@ void expectSameState(const StateDigest& a, const StateDigest& b, const char* wha
       ++missing;
       continue;
     }
-    worst = std::max(worst, (p - it->second).norm());
+    const double d = (p - it->second).norm();
+    if (d > worst) {
+      worst = d;
+      worst_what = "point " + std::to_string(id) + " (node " + std::to_string(core::IdGenerator::node(id)) + ")";
+    }
   }
   EXPECT_EQ(missing, 0) << what;
-  EXPECT_LT(worst, 1e-3) << what;
+  EXPECT_LT(worst, 1e-3) << what << ": " << worst_what;
 }
 
 StateDigest slamState(const core::SlamSystem& slam) {

@@ -144,13 +144,18 @@ void describe(const cv::Mat& smooth, const cv::KeyPoint& kp, cv::Point2f at, uch
     const cv::v_int32x4 row = cv::v_round(vs * x + vc * y), col = cv::v_round(vc * x - vs * y);
     cv::v_store_aligned(&offset[j], row * vstep + col);
   }
-  for (size_t byte = 0; byte < 32; ++byte) {
-    uchar v = 0;
-    for (size_t bit = 0; bit < 8; ++bit) {
-      const size_t t = 2 * (byte * 8 + bit);
-      if (centre[offset[t]] < centre[offset[t + 1]]) v |= static_cast<uchar>(1u << bit);
-    }
-    out[byte] = v;
+  // Pixels gathered first, then compared sixteen tests at a time: a compare-and-branch per
+  // test mispredicted half the time (the outcomes are coin flips), which made this the
+  // costliest part of extraction after FAST.
+  alignas(16) std::array<uchar, 256> first, second;
+  for (size_t t = 0; t < 256; ++t) {
+    first[t] = centre[offset[2 * t]];
+    second[t] = centre[offset[2 * t + 1]];
+  }
+  for (size_t j = 0; j < 256; j += 16) {
+    const int bits = cv::v_signmask(cv::v_load_aligned(&first[j]) < cv::v_load_aligned(&second[j]));
+    out[j / 8] = static_cast<uchar>(bits & 0xff);
+    out[j / 8 + 1] = static_cast<uchar>(bits >> 8);
   }
 }
 

@@ -1,6 +1,7 @@
 #include "core/map/keyframe.hpp"
 
 #include <algorithm>
+#include <unordered_map>
 
 #include "core/map/map_point.hpp"
 
@@ -17,7 +18,11 @@ std::vector<KeyFrame*> KeyFrame::bestCovisible(size_t n) const {
 }
 
 void KeyFrame::updateConnections() {
-  std::map<KeyFrame*, int, ById> counts;
+  // A hash map: this runs for every keyframe of every local map a node applies, and the
+  // ordered map's insertions were most of its cost. Nothing below depends on the order (the
+  // strongest neighbour breaks ties by id).
+  std::unordered_map<KeyFrame*, int> counts;
+  counts.reserve(64);
   for (const auto& p : points) {
     if (!p || p->bad) continue;
     for (const auto& [kf, idx] : p->observations)
