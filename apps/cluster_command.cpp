@@ -124,7 +124,7 @@ ClusterResult runCluster(const ClusterOptions& o) {
     if (status != 0) fmt::print(stderr, "cluster: the {} node ended with status {}\n", task, status);
   }
   if (tr_status != 0) throw InputError(fmt::format("the tr node failed (status {})", tr_status));
-  for (const char* f : {"trajectory.tum", "keyframes.tum", "trajectory.png"})
+  for (const char* f : {"trajectory.tum", "keyframes.tum", "trajectory.png", "frames.csv"})
     if (fs::exists(out / "tr" / f)) fs::copy_file(out / "tr" / f, out / f, fs::copy_options::overwrite_existing);
   ClusterResult r;
   r.reports["tr"] = readReport(out / "tr" / "report.json");

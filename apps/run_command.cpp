@@ -48,6 +48,17 @@ double percentile(std::vector<double> v, double q) {
   return v[std::min(v.size() - 1, static_cast<size_t>(q * (v.size() - 1) + 0.5))];
 }
 
+// One row per frame: what tracking did with it (the trajectory has the tracked frames' poses
+// only). Drift is read against it: inliers that sag after keyframes, keyframes that bunch up.
+void writeFrameLog(const std::filesystem::path& path, const std::vector<core::FrameRecord>& frames) {
+  std::ofstream f(path);
+  f << "index,timestamp,tracked,inliers,keyframe,tracking_ms,map\n";
+  for (const auto& r : frames)
+    f << fmt::format("{},{:.6f},{},{},{},{:.3f},{}\n", r.index, r.timestamp, r.tracked ? 1 : 0, r.inliers,
+                     r.keyframe ? 1 : 0, r.tracking_ms, r.map);
+  if (!f) throw InputError("cannot write " + path.string());
+}
+
 }  // namespace
 
 RunSummary runSlam(const RunOptions& o) {
@@ -182,6 +193,7 @@ RunSummary runSlam(const RunOptions& o) {
   io::writeTrajectory(out / "trajectory.tum", estimate, io::TrajectoryFormat::Tum);
   if (!o.atlas_out.empty()) io::saveAtlas(o.atlas_out, slam.liveMaps());
   io::writeTrajectory(out / "keyframes.tum", keyframes, io::TrajectoryFormat::Tum);
+  writeFrameLog(out / "frames.csv", slam.frames());
 
   nlohmann::json report;
   report["dataset"] = o.dataset;

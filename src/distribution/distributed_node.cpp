@@ -185,6 +185,19 @@ void DistributedNode::keyframeCreated(const std::shared_ptr<core::Map>& map, con
   publisher_->push({map, kf, Topic::TrKeyframes, kTargetLm});
 }
 
+void DistributedNode::keyframeTriangulated(const std::shared_ptr<core::Map>& map,
+                                           const std::shared_ptr<core::KeyFrame>& kf) {
+  // The keyframe and its new points go out before local BA (one small message): TR tracked
+  // 10% fewer points than the standalone system, which sees new points the moment they are
+  // made, while these waited for the BA and the batches before them.
+  if (!plan().local_maps) return;
+  {
+    std::lock_guard lock(mutex_);
+    if (peers_.empty()) return;
+  }
+  handler_->markDirty(map, *kf, Topic::LmMap, 0);
+}
+
 void DistributedNode::keyframeMapped(const std::shared_ptr<core::Map>& map, const std::shared_ptr<core::KeyFrame>& kf) {
   const Plan p = plan();
   bool anyone = false;

@@ -57,6 +57,7 @@ class DistributedNode final : public core::SystemEvents {
   // core::SystemEvents
   void mapCreated(const std::shared_ptr<core::Map>& map) override;
   void keyframeCreated(const std::shared_ptr<core::Map>& map, const std::shared_ptr<core::KeyFrame>& kf) override;
+  void keyframeTriangulated(const std::shared_ptr<core::Map>& map, const std::shared_ptr<core::KeyFrame>& kf) override;
   void keyframeMapped(const std::shared_ptr<core::Map>& map, const std::shared_ptr<core::KeyFrame>& kf) override;
   void globalUpdate(const core::GlobalUpdate& update) override;
 

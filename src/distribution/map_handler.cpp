@@ -98,14 +98,15 @@ void MapHandler::incoming(communication::Message&& m, Topic topic) {
   wake_.notify_all();
 }
 
-void MapHandler::markDirty(const std::shared_ptr<core::Map>& map, const core::KeyFrame& kf, Topic topic) {
+void MapHandler::markDirty(const std::shared_ptr<core::Map>& map, const core::KeyFrame& kf, Topic topic, int window) {
   std::vector<core::Id> kfs, points;
   {
     std::lock_guard lock(map->mutex);
     if (kf.bad) return;
-    std::vector<const core::KeyFrame*> window{&kf};
-    for (const core::KeyFrame* n : kf.bestCovisible(static_cast<size_t>(settings_.local_window))) window.push_back(n);
-    for (const core::KeyFrame* k : window) {
+    std::vector<const core::KeyFrame*> changed{&kf};
+    for (const core::KeyFrame* n : kf.bestCovisible(static_cast<size_t>(window < 0 ? settings_.local_window : window)))
+      changed.push_back(n);
+    for (const core::KeyFrame* k : changed) {
       kfs.push_back(k->id);
       for (const auto& p : k->points)
         if (p && !p->bad) points.push_back(p->id);

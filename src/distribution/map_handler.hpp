@@ -45,8 +45,10 @@ class MapHandler {
   ~MapHandler();
 
   void incoming(communication::Message&& m, communication::Topic topic);
-  // Local mapping finished `kf`: it and its covisible keyframes changed (sent on `topic`).
-  void markDirty(const std::shared_ptr<core::Map>& map, const core::KeyFrame& kf, communication::Topic topic);
+  // Local mapping changed `kf` and up to `window` of its covisible keyframes (the setting's
+  // local_window when negative), sent on `topic` with the points they see.
+  void markDirty(const std::shared_ptr<core::Map>& map, const core::KeyFrame& kf, communication::Topic topic,
+                 int window = -1);
   // The whole map, as a global map of `epoch`, on `topic`.
   // `full`: every point with its full record and every keyframe with its links (a snapshot for
   // a node that may have missed updates: a newcomer, or the end of a run).

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <map>
+#include <mutex>
 #include <string>
 
 #include "core/camera/pinhole_radtan.hpp"
@@ -142,6 +143,61 @@ TEST(SlamSystem, SequentialModeIsDeterministic) {
   ASSERT_GT(a.estimate.size(), 40u);
   for (size_t i = 0; i < a.estimate.size(); ++i)
     EXPECT_EQ(a.estimate.poses[i].matrix(), b.estimate.poses[i].matrix()) << i;
+}
+
+// The distribution layer sends a keyframe's new points before local BA (TR tracks with them a
+// BA earlier): the event comes once per mapped keyframe, before keyframeMapped, with the
+// keyframe already seeing points it did not see when tracking made it.
+TEST(SlamSystem, NewPointsAreReportedBeforeLocalBa) {
+  struct Recorder : SystemEvents {
+    std::mutex mutex;
+    std::map<Id, size_t> at_creation, at_triangulation;
+    std::vector<Id> order;  // +id: triangulated, -id: mapped
+    static size_t seen(const std::shared_ptr<Map>& map, const KeyFrame& kf) {
+      std::lock_guard lock(map->mutex);
+      size_t n = 0;
+      for (const auto& p : kf.points) n += p && !p->bad;
+      return n;
+    }
+    void keyframeTriangulated(const std::shared_ptr<Map>& map, const std::shared_ptr<KeyFrame>& kf) override {
+      const size_t n = seen(map, *kf);
+      std::lock_guard lock(mutex);
+      at_triangulation[kf->id] = n;
+      order.push_back(static_cast<Id>(kf->id));
+    }
+    void keyframeMapped(const std::shared_ptr<Map>&, const std::shared_ptr<KeyFrame>& kf) override {
+      std::lock_guard lock(mutex);
+      order.push_back(~static_cast<Id>(kf->id));
+    }
+  } recorder;
+  synth::SequenceOptions o;
+  o.trajectory = "sweep";
+  o.frames = 600;
+  o.seed = 4;
+  const auto model = synth::buildSequence(o);
+  const synth::RayTable rays(model.lens);
+  auto camera = std::make_shared<camera::PinholeRadTan>(model.lens.width, model.lens.height, model.lens.fx,
+                                                        model.lens.fy, model.lens.cx, model.lens.cy);
+  SlamSystem slam(SlamSettings{}, camera, SlamSystem::Mode::Offline);
+  slam.setEvents(&recorder);
+  for (int f = 100; f < 180; ++f) slam.process(model.renderImage(f, rays), model.stamp(f));
+  slam.finish();
+  std::lock_guard lock(recorder.mutex);
+  ASSERT_GE(recorder.at_triangulation.size(), 5u);
+  // Each keyframe: triangulated, then mapped, never the other way round.
+  std::map<Id, int> state;
+  for (Id e : recorder.order) {
+    const bool mapped = static_cast<int64_t>(e) < 0;
+    const Id id = mapped ? ~e : e;
+    EXPECT_EQ(state[id], mapped ? 1 : 0) << id;
+    state[id] = mapped ? 2 : 1;
+  }
+  // Triangulation added points: each keyframe sees more than tracking linked it to.
+  size_t grew = 0;
+  for (const auto& r : slam.frames())
+    if (r.keyframe && r.reference && recorder.at_triangulation.count(r.reference->id))
+      grew += recorder.at_triangulation[r.reference->id] > static_cast<size_t>(r.inliers);
+  EXPECT_GE(grew, recorder.at_triangulation.size() / 2);
 }
 
 }  // namespace

@@ -28,7 +28,7 @@ struct LocalMapper::LocalBa {
 };
 
 void LocalMapper::process(const std::shared_ptr<Map>& map, const std::shared_ptr<KeyFrame>& kf,
-                          const std::atomic<bool>* abort_ba) {
+                          const std::atomic<bool>* abort_ba, const std::function<void()>& before_ba) {
   std::unique_lock lock(map->mutex);
   // Merged into another map since the job was queued: the keyframe is in the old frame and
   // the map is empty (SlamSystem drops such jobs; this closes the gap until the lock).
@@ -41,6 +41,7 @@ void LocalMapper::process(const std::shared_ptr<Map>& map, const std::shared_ptr
   if (map->keyframes.size() > 2) {
     LocalBa ba = prepareLocalBa(*map, *kf);
     lock.unlock();
+    if (before_ba) before_ba();
     BaOptions o;
     o.iterations = settings_.local_ba_iterations;
     o.abort = abort_ba;
@@ -49,6 +50,11 @@ void LocalMapper::process(const std::shared_ptr<Map>& map, const std::shared_ptr
     lock.lock();
     applyLocalBa(*map, ba);
     if (map->merged_into.load()) return;  // merged during the BA: its keyframes live elsewhere
+  } else if (before_ba) {
+    lock.unlock();
+    before_ba();
+    lock.lock();
+    if (map->merged_into.load()) return;
   }
   cullKeyframes(*map, *kf);
   ++stats_.keyframes_processed;

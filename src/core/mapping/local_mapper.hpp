@@ -2,6 +2,7 @@
 // The local mapping module: inserts keyframes from tracking into the map, culls weak recent
 // points, triangulates new points with covisible keyframes, fuses duplicates, runs local BA
 // and culls redundant keyframes.
+#include <functional>
 #include <atomic>
 #include <list>
 #include <memory>
@@ -23,9 +24,10 @@ class LocalMapper {
   LocalMapper(const SlamSettings& settings, IdGenerator& ids, std::vector<double> scales);
 
   // Runs every step for one keyframe of `map` (the caller holds no lock; each step takes the
-  // map's mutex). `abort_ba` lets a newer keyframe cut the local BA short.
+  // map's mutex). `abort_ba` lets a newer keyframe cut the local BA short; `before_ba` runs
+  // with no lock held once the keyframe's new points are in the map, before local BA.
   void process(const std::shared_ptr<Map>& map, const std::shared_ptr<KeyFrame>& kf,
-               const std::atomic<bool>* abort_ba = nullptr);
+               const std::atomic<bool>* abort_ba = nullptr, const std::function<void()>& before_ba = {});
   const MappingStats& stats() const { return stats_; }
   // Inserted keyframes enter the place recognition database, culled ones leave it.
   void setDatabase(KeyframeDatabase* database) { database_ = database; }

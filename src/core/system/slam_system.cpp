@@ -93,7 +93,7 @@ void SlamSystem::submit(const std::shared_ptr<Map>& map, const std::shared_ptr<K
     return;
   }
   if (mode_ == Mode::Sequential) {
-    mapper_.process(map, kf);
+    mapper_.process(map, kf, nullptr, beforeBa(map, kf));
     if (events_) events_->keyframeMapped(map, kf);
     if (hosting_loop_closing_) closer_.process(map, kf);
     return;
@@ -133,6 +133,11 @@ void SlamSystem::drain() {
   while (loop_jobs_pending_ > 0) std::this_thread::sleep_for(std::chrono::milliseconds(5));
 }
 
+std::function<void()> SlamSystem::beforeBa(const std::shared_ptr<Map>& map, const std::shared_ptr<KeyFrame>& kf) const {
+  if (!events_) return {};
+  return [this, map, kf] { events_->keyframeTriangulated(map, kf); };
+}
+
 void SlamSystem::mappingLoop() {
   while (auto job = jobs_.pop()) {
     mapping_busy_ = true;
@@ -142,7 +147,7 @@ void SlamSystem::mappingLoop() {
     if (job->map->merged_into.load()) {
       ++stale_keyframes_;
     } else {
-      mapper_.process(job->map, job->keyframe, &abort_ba_);
+      mapper_.process(job->map, job->keyframe, &abort_ba_, beforeBa(job->map, job->keyframe));
       if (events_) events_->keyframeMapped(job->map, job->keyframe);
       if (hosting_loop_closing_) {
         ++loop_jobs_pending_;
@@ -189,7 +194,7 @@ const FrameRecord& SlamSystem::process(const cv::Mat& gray, double timestamp) {
       }
       if (events_) events_->keyframeCreated(tracker_.map(), out.new_keyframe);
     } else if (mode_ == Mode::Sequential) {
-      mapper_.process(tracker_.map(), out.new_keyframe);
+      mapper_.process(tracker_.map(), out.new_keyframe, nullptr, beforeBa(tracker_.map(), out.new_keyframe));
       if (events_) events_->keyframeMapped(tracker_.map(), out.new_keyframe);
       if (hosting_loop_closing_) closer_.process(tracker_.map(), out.new_keyframe);
     } else {

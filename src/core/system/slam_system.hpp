@@ -122,6 +122,8 @@ class SlamSystem {
     std::shared_ptr<KeyFrame> keyframe;
   };
   void mappingLoop();
+  // What local mapping calls before its local BA: the keyframeTriangulated event, if anyone listens.
+  std::function<void()> beforeBa(const std::shared_ptr<Map>& map, const std::shared_ptr<KeyFrame>& kf) const;
   void loopLoop();
   void waitForMapping();
   Mode mode_;

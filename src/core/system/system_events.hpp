@@ -17,6 +17,9 @@ class SystemEvents {
   // Tracking made a keyframe that local mapping will process elsewhere; it is already in the
   // map, linked to the points tracking matched (tracking thread).
   virtual void keyframeCreated(const std::shared_ptr<Map>&, const std::shared_ptr<KeyFrame>&) {}
+  // Local mapping made a keyframe's new points and fused duplicates, and is about to run local
+  // BA (mapping thread, no lock held).
+  virtual void keyframeTriangulated(const std::shared_ptr<Map>&, const std::shared_ptr<KeyFrame>&) {}
   // Local mapping finished a keyframe: points triangulated and fused, local BA applied
   // (mapping thread).
   virtual void keyframeMapped(const std::shared_ptr<Map>&, const std::shared_ptr<KeyFrame>&) {}
