@@ -112,17 +112,28 @@ TEST(SlamSystem, ClosesNoLoopOnASequenceThatNeverRevisits) {
   EXPECT_EQ(run.merges, 0);
 }
 
+// The sweep sequence (600 frames, seed 4), its ray table and an ideal pinhole camera.
+struct Sweep {
+  static synth::SequenceModel build() {
+    synth::SequenceOptions o;
+    o.trajectory = "sweep";
+    o.frames = 600;
+    o.seed = 4;
+    return synth::buildSequence(o);
+  }
+  synth::SequenceModel model = build();
+  synth::RayTable rays{model.lens};
+  std::shared_ptr<camera::PinholeRadTan> camera = std::make_shared<camera::PinholeRadTan>(
+      model.lens.width, model.lens.height, model.lens.fx, model.lens.fy, model.lens.cx, model.lens.cy);
+};
+
 // Kidnapped: after 120 frames the camera jumps back to where it was at frame 40. Tracking must
 // lose the pose, find the place again through the keyframe database and go on in the same map.
 TEST(SlamSystem, RelocalizesAfterAJumpBackWithoutLoopClosing) {
-  synth::SequenceOptions o;
-  o.trajectory = "sweep";
-  o.frames = 600;
-  o.seed = 4;
-  const auto model = synth::buildSequence(o);
-  const synth::RayTable rays(model.lens);
-  auto camera = std::make_shared<camera::PinholeRadTan>(model.lens.width, model.lens.height, model.lens.fx,
-                                                        model.lens.fy, model.lens.cx, model.lens.cy);
+  const Sweep sweep;
+  const auto& model = sweep.model;
+  const auto& rays = sweep.rays;
+  const auto& camera = sweep.camera;
   SlamSettings settings;
   settings.loop_closing = false;
   SlamSystem slam(settings, camera, SlamSystem::Mode::Sequential, shippedVocabulary());
@@ -170,14 +181,10 @@ TEST(SlamSystem, NewPointsAreReportedBeforeLocalBa) {
       order.push_back(~static_cast<Id>(kf->id));
     }
   } recorder;
-  synth::SequenceOptions o;
-  o.trajectory = "sweep";
-  o.frames = 600;
-  o.seed = 4;
-  const auto model = synth::buildSequence(o);
-  const synth::RayTable rays(model.lens);
-  auto camera = std::make_shared<camera::PinholeRadTan>(model.lens.width, model.lens.height, model.lens.fx,
-                                                        model.lens.fy, model.lens.cx, model.lens.cy);
+  const Sweep sweep;
+  const auto& model = sweep.model;
+  const auto& rays = sweep.rays;
+  const auto& camera = sweep.camera;
   SlamSystem slam(SlamSettings{}, camera, SlamSystem::Mode::Offline);
   slam.setEvents(&recorder);
   for (int f = 100; f < 180; ++f) slam.process(model.renderImage(f, rays), model.stamp(f));
