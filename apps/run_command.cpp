@@ -52,10 +52,13 @@ double percentile(std::vector<double> v, double q) {
 // only). Drift is read against it: inliers that sag after keyframes, keyframes that bunch up.
 void writeFrameLog(const std::filesystem::path& path, const std::vector<core::FrameRecord>& frames) {
   std::ofstream f(path);
-  f << "index,timestamp,tracked,inliers,keyframe,tracking_ms,map\n";
+  // reference: the keyframe the pose is kept relative to; reference_culled: it was erased
+  // later, and the pose follows it through its spanning-tree parent.
+  f << "index,timestamp,tracked,inliers,keyframe,tracking_ms,map,reference,reference_culled\n";
   for (const auto& r : frames)
-    f << fmt::format("{},{:.6f},{},{},{},{:.3f},{}\n", r.index, r.timestamp, r.tracked ? 1 : 0, r.inliers,
-                     r.keyframe ? 1 : 0, r.tracking_ms, r.map);
+    f << fmt::format("{},{:.6f},{},{},{},{:.3f},{},{},{}\n", r.index, r.timestamp, r.tracked ? 1 : 0, r.inliers,
+                     r.keyframe ? 1 : 0, r.tracking_ms, r.map, r.reference ? r.reference->id : core::kNoId,
+                     r.reference && r.reference->bad ? 1 : 0);
   if (!f) throw InputError("cannot write " + path.string());
 }
 
