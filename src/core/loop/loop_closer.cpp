@@ -473,7 +473,10 @@ void LoopCloser::mergeMaps(Map& map, KeyFrame& kf, Map& other, const Verified& v
   // other's world -> this map's world.
   const Sim3 S_ab = Sim3(kf.T_cw).inverse() * v.S_cw;
   const Sim3 S_ba = S_ab.inverse();
-  for (const auto& [id, k] : other.keyframes) k->T_cw = (Sim3(k->T_cw) * S_ba).toPose();
+  for (const auto& [id, k] : other.keyframes) {
+    k->T_cw = (Sim3(k->T_cw) * S_ba).toPose();
+    k->scale_change *= S_ab.s;
+  }
   for (const auto& [id, p] : other.points) p->position = S_ab * p->position;
   map.absorb(other);
   database_.moveMap(&other, &map);

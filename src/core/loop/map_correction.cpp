@@ -1,11 +1,42 @@
 #include "core/loop/map_correction.hpp"
 
+#include <algorithm>
+#include <vector>
+
+#include "core/map/map_point.hpp"
+
 namespace hiveslam::core {
+
+namespace {
+
+// Rigid poses and moved points (a global BA; a merge made at another node arrives so) still
+// rescale the map around a keyframe: how far its points are from it now, against before.
+double scaleChange(const KeyFrame& kf, const Sim3& before, const Sim3& after,
+                   const std::unordered_map<MapPoint*, Eigen::Vector3d>& moved) {
+  std::vector<double> ratios;
+  for (const auto& p : kf.points) {
+    if (!p || p->bad) continue;
+    auto it = moved.find(p.get());
+    if (it == moved.end()) continue;
+    const double was = (before * p->position).norm(), is = (after * it->second).norm();
+    if (was > 1e-9 && is > 1e-9) ratios.push_back(is / was);
+  }
+  if (ratios.size() < 8) return 1.0;
+  auto mid = ratios.begin() + static_cast<std::ptrdiff_t>(ratios.size() / 2);
+  std::nth_element(ratios.begin(), mid, ratios.end());
+  return *mid;
+}
+
+}  // namespace
 
 void applyCorrection(Map& map, const PoseCorrection& c, const std::vector<double>& scales) {
   // Correction of every keyframe, live or retired: old world -> new world.
   std::unordered_map<KeyFrame*, Sim3> moves;
-  for (const auto& [kf, after] : c.after) moves[kf] = after.inverse() * c.before.at(kf);
+  for (const auto& [kf, after] : c.after) {
+    const Sim3& before = c.before.at(kf);
+    moves[kf] = after.inverse() * Sim3(Eigen::Quaterniond::Identity(), Eigen::Vector3d::Zero(),
+                                       c.points.empty() ? 1.0 : scaleChange(*kf, before, after, c.points)) * before;
+  }
   auto correctionOf = [&](KeyFrame* kf) {
     std::vector<KeyFrame*> chain;
     KeyFrame* k = kf;
@@ -37,8 +68,14 @@ void applyCorrection(Map& map, const PoseCorrection& c, const std::vector<double
     }
   }
   for (const auto& [kf, after] : c.after)
-    if (!kf->bad) kf->T_cw = after.toPose();
-  for (const auto& [kf, C] : inherited) kf->T_cw = (Sim3(kf->T_cw) * C.inverse()).toPose();
+    if (!kf->bad) {
+      kf->T_cw = after.toPose();
+      kf->scale_change *= moves.at(kf).s;
+    }
+  for (const auto& [kf, C] : inherited) {
+    kf->T_cw = (Sim3(kf->T_cw) * C.inverse()).toPose();
+    kf->scale_change *= C.s;
+  }
   for (const auto& [id, p] : map.points)
     if (!p->bad) p->update(scales);
   ++map.epoch;

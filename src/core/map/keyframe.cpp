@@ -7,6 +7,40 @@
 
 namespace hiveslam::core {
 
+std::pair<Eigen::Isometry3d, double> KeyFrame::placement() const {
+  // Down the anchors to a live keyframe, then back up: culled keyframes can chain (an anchor
+  // culled in turn), and a loop keeps this linear in the chain's length.
+  std::vector<const KeyFrame*> chain;
+  const KeyFrame* k = this;
+  while (k->bad && k->anchor) {
+    chain.push_back(k);
+    k = k->anchor;
+  }
+  Eigen::Isometry3d T = k->T_cw;
+  double s = k->scale_change;
+  for (auto it = chain.rbegin(); it != chain.rend(); ++it) {
+    const RelativePose& r = (*it)->from_anchor;
+    const double change = s / r.scale;
+    Eigen::Isometry3d T_c_k = r.T_c_k;
+    T_c_k.translation() *= change;
+    T = T_c_k * T;
+    s = (*it)->scale_change * change;
+  }
+  return {T, s};
+}
+
+RelativePose KeyFrame::relative(const Eigen::Isometry3d& T) const {
+  const auto [T_kw, s] = bad && anchor ? placement() : std::pair{T_cw, scale_change};
+  return {T * T_kw.inverse(), s};
+}
+
+Eigen::Isometry3d KeyFrame::poseOf(const RelativePose& r) const {
+  const auto [T_kw, s] = bad && anchor ? placement() : std::pair{T_cw, scale_change};
+  Eigen::Isometry3d T = r.T_c_k;
+  T.translation() *= s / r.scale;
+  return T * T_kw;
+}
+
 std::vector<KeyFrame*> KeyFrame::bestCovisible(size_t n) const {
   std::vector<std::pair<int, KeyFrame*>> v;
   for (const auto& [kf, w] : covisibility)

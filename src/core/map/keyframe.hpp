@@ -6,6 +6,7 @@
 #include <map>
 #include <memory>
 #include <set>
+#include <utility>
 #include <vector>
 
 #include "core/frame/frame.hpp"
@@ -15,6 +16,15 @@
 namespace hiveslam::core {
 
 class MapPoint;
+
+// A camera pose held relative to a keyframe (a tracked frame's, a culled keyframe's): it
+// follows the keyframe through every later correction, the map's scale around it included. A
+// merge or a loop correction rescales a region by a few percent, and a rigid offset one metre
+// long would then be centimetres off.
+struct RelativePose {
+  Eigen::Isometry3d T_c_k = Eigen::Isometry3d::Identity();
+  double scale = 1.0;  // the keyframe's scale() when the pose was taken
+};
 
 class KeyFrame : public std::enable_shared_from_this<KeyFrame> {
  public:
@@ -35,18 +45,23 @@ class KeyFrame : public std::enable_shared_from_this<KeyFrame> {
   // Loop and merge links: kept by the essential graph, and never culled.
   std::set<KeyFrame*, ById> loop_edges;
 
-  // A culled keyframe keeps its pose relative to its parent (set when it leaves the map): frames
-  // tracked against it follow every later correction of the map through pose().
-  Eigen::Isometry3d T_c_parent = Eigen::Isometry3d::Identity();
+  // How much corrections (merges, loop corrections, global BA) have scaled the map around this
+  // keyframe since it was made. For a culled keyframe: the value when it was culled.
+  double scale_change = 1.0;
+  // A culled keyframe follows the live keyframe that shared the most points with it then.
+  KeyFrame* anchor = nullptr;
+  RelativePose from_anchor;
   // Where tracking posed it: the map's epoch then and its pose relative to tracking's reference
   // keyframe. A keyframe that waited in the queue through a correction is re-posed from these.
   uint64_t made_in_epoch = 0;
   KeyFrame* made_from = nullptr;
   Eigen::Isometry3d T_made_from = Eigen::Isometry3d::Identity();
-  // The current pose: T_cw, or for a culled keyframe its pose through the spanning tree.
-  Eigen::Isometry3d pose() const {
-    return bad && parent ? T_c_parent * parent->pose() : T_cw;
-  }
+  // The current pose and scale change: a live keyframe's own, a culled one's through its anchor.
+  Eigen::Isometry3d pose() const { return bad && anchor ? placement().first : T_cw; }
+  double scale() const { return bad && anchor ? placement().second : scale_change; }
+  // `T_cw` held relative to this keyframe, and back.
+  RelativePose relative(const Eigen::Isometry3d& T_cw) const;
+  Eigen::Isometry3d poseOf(const RelativePose& r) const;
 
   Eigen::Vector3d center() const { return T_cw.inverse().translation(); }
   // Keyframes sharing the most points, best first.
@@ -55,6 +70,9 @@ class KeyFrame : public std::enable_shared_from_this<KeyFrame> {
   // this keyframe has none).
   void updateConnections();
   int trackedPoints(int min_observations) const;
+
+ private:
+  std::pair<Eigen::Isometry3d, double> placement() const;
 };
 
 }  // namespace hiveslam::core

@@ -61,7 +61,21 @@ void Map::erase(KeyFrame& kf) {
   if (&kf == origin) return;  // the origin anchors the map's coordinate frame
   auto it = keyframes.find(kf.id);
   if (it == keyframes.end() || it->second.get() != &kf) return;  // not (or no longer) this map's
-  if (kf.parent) kf.T_c_parent = kf.T_cw * kf.parent->pose().inverse();
+  // The anchor is the live keyframe sharing the most points: a close neighbour, where the
+  // spanning tree parent can be one that is far away by now (culled parents pass their children
+  // up the tree), and a correction that bends or rescales the map between them would carry
+  // over.
+  KeyFrame* anchor = kf.parent;
+  int most = 0;
+  for (const auto& [other, w] : kf.covisibility)
+    if (!other->bad && (w > most || (w == most && anchor && other->id < anchor->id))) {
+      anchor = other;
+      most = w;
+    }
+  if (anchor) {
+    kf.from_anchor = anchor->relative(kf.T_cw);
+    kf.anchor = anchor;
+  }
   kf.bad = true;
   for (auto& p : kf.points)
     if (p) {

@@ -211,7 +211,7 @@ const FrameRecord& SlamSystem::process(const cv::Mat& gray, double timestamp) {
 }
 
 Eigen::Isometry3d SlamSystem::poseOf(const FrameRecord& r) const {
-  return (r.T_c_ref * r.reference->pose()).inverse();
+  return r.reference->poseOf(r.T_c_ref).inverse();
 }
 
 void SlamSystem::loadAtlas(const std::vector<std::shared_ptr<Map>>& maps, bool localization_only) {

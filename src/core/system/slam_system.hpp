@@ -27,7 +27,7 @@ struct FrameRecord {
   double timestamp = 0;
   bool tracked = false;
   std::shared_ptr<KeyFrame> reference;
-  Eigen::Isometry3d T_c_ref = Eigen::Isometry3d::Identity();  // pose relative to the reference
+  RelativePose T_c_ref;  // pose relative to the reference
   Id map = kNoId;
   double tracking_ms = 0;
   int inliers = 0;       // map points tracked

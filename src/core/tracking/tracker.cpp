@@ -37,7 +37,7 @@ TrackingOutput Tracker::track(Frame frame, bool mapping_idle) {
   // Loop closing, a merge or a global BA moved the map: the last frame's pose is re-derived
   // from its reference keyframe, as the motion model predicts from it.
   if (map_->epoch != epoch_seen_) {
-    if (last_ && last_reference_) last_->T_cw = last_T_c_ref_ * last_reference_->pose();
+    if (last_ && last_reference_) last_->T_cw = last_reference_->poseOf(last_T_c_ref_);
     epoch_seen_ = map_->epoch;
   }
   bool ok = false;
@@ -99,7 +99,7 @@ TrackingOutput Tracker::track(Frame frame, bool mapping_idle) {
     last_keyframe_frame_ = current.frame.index;
   }
   out.reference = reference_;
-  out.T_c_ref = current.T_cw * reference_->pose().inverse();
+  out.T_c_ref = reference_->relative(current.T_cw);
   last_reference_ = reference_;
   last_T_c_ref_ = out.T_c_ref;
   epoch_seen_ = map_->epoch;
@@ -220,7 +220,7 @@ bool Tracker::initialize(Tracked& current, TrackingOutput& out) {
   map_ = map;
   epoch_seen_ = map->epoch;
   last_reference_ = kf2;
-  last_T_c_ref_ = Eigen::Isometry3d::Identity();
+  last_T_c_ref_ = kf2->relative(kf2->T_cw);
   keyframes_made_ = 2;
   reference_ = kf2;
   current.T_cw = kf2->T_cw;
@@ -234,7 +234,7 @@ bool Tracker::initialize(Tracked& current, TrackingOutput& out) {
   out.new_keyframe = kf2;
   out.reference = kf2;
   out.T_cw = kf2->T_cw;
-  out.T_c_ref = Eigen::Isometry3d::Identity();
+  out.T_c_ref = last_T_c_ref_;
   out.inliers = static_cast<int>(map->points.size());
   return true;
 }

@@ -21,7 +21,7 @@ struct TrackingOutput {
   bool tracked = false;
   Eigen::Isometry3d T_cw = Eigen::Isometry3d::Identity();
   std::shared_ptr<KeyFrame> reference;      // the pose is kept relative to it
-  Eigen::Isometry3d T_c_ref = Eigen::Isometry3d::Identity();  // taken under the map lock
+  RelativePose T_c_ref;                     // taken under the map lock
   std::shared_ptr<KeyFrame> new_keyframe;   // for local mapping (also the initial two)
   std::shared_ptr<Map> new_map;             // set when initialization created a map
   int inliers = 0;
@@ -92,7 +92,7 @@ class Tracker {
   const KeyframeDatabase* database_ = nullptr;
   // The last frame relative to its reference keyframe, and the map epoch it was posed in.
   std::shared_ptr<KeyFrame> last_reference_;
-  Eigen::Isometry3d last_T_c_ref_ = Eigen::Isometry3d::Identity();
+  RelativePose last_T_c_ref_;
   uint64_t epoch_seen_ = 0;
   bool localization_only_ = false;
 };

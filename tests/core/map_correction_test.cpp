@@ -1,0 +1,104 @@
+// Culled keyframes and tracked frames keep their poses relative to live keyframes; a correction
+// that moves and rescales the map (a merge, a loop correction) must carry them along exactly as
+// it carries the live map, or the trajectory shows the old scale wherever frames referred to a
+// culled keyframe.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "core/loop/map_correction.hpp"
+
+namespace hiveslam::core {
+namespace {
+
+// Six keyframes 0.3 m apart along x, all looking down +z at a wall of points 3-5 m away; each
+// sees the points within 1.2 m of its own x. One slot per point keeps the bookkeeping trivial.
+struct Corridor {
+  Map map{1};
+  std::vector<std::shared_ptr<KeyFrame>> kfs;
+  std::vector<std::shared_ptr<MapPoint>> points;
+
+  Corridor() {
+    for (int i = 0; i < 120; ++i) {
+      const Eigen::Vector3d X(-1.0 + 0.03 * i, 0.2 * std::sin(i), 3.0 + 2.0 * ((i * 7) % 11) / 10.0);
+      points.push_back(std::make_shared<MapPoint>(1000 + static_cast<Id>(i), X, 1));
+      map.add(points.back());
+    }
+    for (int k = 0; k < 6; ++k) {
+      Frame f;
+      f.keypoints.resize(points.size());
+      f.points.resize(points.size(), Eigen::Vector2d::Zero());
+      f.descriptors = cv::Mat::zeros(static_cast<int>(points.size()), 32, CV_8U);
+      Eigen::Isometry3d T_cw = Eigen::Isometry3d::Identity();
+      T_cw.translation() = -Eigen::Vector3d(0.3 * k, 0, 0);
+      auto kf = std::make_shared<KeyFrame>(static_cast<Id>(k + 1), f, T_cw);
+      map.add(kf);
+      for (size_t i = 0; i < points.size(); ++i)
+        if (std::abs(points[i]->position.x() - 0.3 * k) < 1.2) Map::observe(*kf, static_cast<int>(i), points[i]);
+      kfs.push_back(kf);
+    }
+    map.origin = kfs[0].get();
+    for (auto& kf : kfs) kf->updateConnections();
+  }
+};
+
+Sim3 someSimilarity() {
+  return {Eigen::Quaterniond(Eigen::AngleAxisd(0.3, Eigen::Vector3d(1, 2, 3).normalized())),
+          Eigen::Vector3d(0.4, -1.0, 2.0), 1.04};
+}
+
+// T_cw after moving the world by S (x -> S x).
+Eigen::Isometry3d moved(const Eigen::Isometry3d& T_cw, const Sim3& S) { return (Sim3(T_cw) * S.inverse()).toPose(); }
+
+void expectPose(const Eigen::Isometry3d& want, const Eigen::Isometry3d& got, const char* what) {
+  EXPECT_LT((want.translation() - got.translation()).norm(), 1e-9) << what;
+  EXPECT_LT(Eigen::AngleAxisd(want.linear().transpose() * got.linear()).angle(), 1e-9) << what;
+}
+
+// rigid: the correction comes as rigid poses and moved points (global BA; a merge as another
+// node receives it); otherwise as similarity poses (the essential graph).
+void culledKeyframesFollowAScaledMove(bool rigid) {
+  Corridor c;
+  // Cull keyframes 2 and then 3: keyframe 2's closest live neighbour is culled in turn.
+  const Eigen::Isometry3d T2 = c.kfs[2]->T_cw, T3 = c.kfs[3]->T_cw;
+  Eigen::Isometry3d T_frame = T3;
+  T_frame.translation() += Eigen::Vector3d(-0.05, 0.01, 0.02);
+  c.map.erase(*c.kfs[2]);
+  c.map.erase(*c.kfs[3]);
+  ASSERT_TRUE(c.kfs[2]->bad && c.kfs[3]->bad);
+  ASSERT_NE(c.kfs[2]->anchor, nullptr);
+  const RelativePose frame = c.kfs[3]->relative(T_frame);
+  expectPose(T2, c.kfs[2]->pose(), "keyframe 2 before");
+  expectPose(T_frame, c.kfs[3]->poseOf(frame), "frame before");
+
+  const Sim3 S = someSimilarity();
+  PoseCorrection correction;
+  for (const auto& [id, kf] : c.map.keyframes) {
+    correction.before[kf.get()] = Sim3(kf->T_cw);
+    correction.after[kf.get()] = rigid ? Sim3(moved(kf->T_cw, S)) : Sim3(kf->T_cw) * S.inverse();
+  }
+  if (rigid)
+    for (const auto& [id, p] : c.map.points) correction.points[p.get()] = S * p->position;
+  applyCorrection(c.map, correction, {1.0});
+
+  expectPose(moved(T2, S), c.kfs[2]->pose(), "keyframe 2");
+  expectPose(moved(T3, S), c.kfs[3]->pose(), "keyframe 3");
+  expectPose(moved(T_frame, S), c.kfs[3]->poseOf(frame), "frame");
+  EXPECT_NEAR(c.kfs[3]->scale(), S.s, 1e-9);
+}
+
+TEST(MapCorrection, CulledKeyframesFollowARigidCorrectionWithMovedPoints) { culledKeyframesFollowAScaledMove(true); }
+
+TEST(MapCorrection, CulledKeyframesFollowASimilarityCorrection) { culledKeyframesFollowAScaledMove(false); }
+
+TEST(MapCorrection, ACulledKeyframeFollowsItsClosestNeighbourNotADistantParent) {
+  Corridor c;
+  // Keyframe 5's spanning tree parent is made the far origin; it shares the most points with 4.
+  c.kfs[5]->parent->children.erase(c.kfs[5].get());
+  c.kfs[5]->parent = c.kfs[0].get();
+  c.map.erase(*c.kfs[5]);
+  EXPECT_EQ(c.kfs[5]->anchor, c.kfs[4].get());
+}
+
+}  // namespace
+}  // namespace hiveslam::core
