@@ -279,7 +279,7 @@ void addRunCommand(CLI::App& app) {
   cmd->add_option("--calibration", o->calibration, "With --topic: camera file (settings YAML, sensor.yaml or calib.txt)");
   cmd->add_option("--domain", o->topic_domain, "With --topic: DDS domain id (the ROS_DOMAIN_ID)")->capture_default_str();
   cmd->add_option("--ground-truth", o->ground_truth, "Score against this dataset's ground truth (for --topic)");
-  cmd->add_option("--config", o->config, "Settings YAML (camera section)");
+  cmd->add_option("--config", o->config, "Settings YAML: its camera section replaces the dataset's calibration, its slam and distribution sections override the defaults");
   cmd->add_option("--times", o->times, "Times file for image folders and videos");
   cmd->add_option("--out", o->out, "Output folder")->required();
   cmd->add_flag("--sequential", o->sequential, "Lockstep tracking and mapping on one thread (deterministic)");

@@ -86,6 +86,8 @@ T optional(const YAML::Node& node, const std::string& key, T fallback,
 
 }  // namespace
 
+bool hasCameraSection(const std::filesystem::path& path) { return static_cast<bool>(loadYaml(path)["camera"]); }
+
 CameraSettings loadSettingsCamera(const std::filesystem::path& path) {
   const YAML::Node root = loadYaml(path);
   const YAML::Node cam = root["camera"];

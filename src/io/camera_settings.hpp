@@ -28,6 +28,9 @@ std::shared_ptr<const camera::CameraModel> makeCamera(const std::string& model, 
                                                       const std::string& source);
 
 CameraSettings loadSettingsCamera(const std::filesystem::path& settings_yaml);
+// Whether a settings file has a `camera:` section (one with only `slam:` settings leaves the
+// calibration to the dataset).
+bool hasCameraSection(const std::filesystem::path& settings_yaml);
 CameraSettings loadEurocSensorYaml(const std::filesystem::path& sensor_yaml);
 CameraSettings loadCalibTxt(const std::filesystem::path& calib_txt);
 

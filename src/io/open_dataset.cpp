@@ -9,8 +9,9 @@ namespace fs = std::filesystem;
 CameraSettings resolveCamera(const DatasetOptions& options, const std::optional<fs::path>& fallback,
                              CameraSettings (*load_fallback)(const fs::path&),
                              const fs::path& dataset) {
-  if (options.settings) return loadSettingsCamera(*options.settings);
-  if (fallback && fs::exists(*fallback)) return load_fallback(*fallback);
+  const bool own = fallback && fs::exists(*fallback);
+  if (options.settings && (!own || hasCameraSection(*options.settings))) return loadSettingsCamera(*options.settings);
+  if (own) return load_fallback(*fallback);
   throw InputError("no camera calibration for " + dataset.string() +
                    ": pass a settings file with --config");
 }

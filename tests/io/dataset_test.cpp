@@ -62,6 +62,16 @@ TEST(EurocDataset, ReadsASyntheticSequenceWithGroundTruth) {
   EXPECT_EQ(openDataset(dir / "mav0")->size(), 6u);
 }
 
+TEST(EurocDataset, ASettingsFileWithoutCameraKeepsTheDatasetCalibration) {
+  testing::TempDir dir;
+  synth::writeSequence(tiny(2), dir.path());
+  std::ofstream(dir / "slam_only.yaml") << "slam:\n  local_ba_iterations: 20\n";
+  EXPECT_EQ(openDataset(dir.path(), {dir / "slam_only.yaml", std::nullopt})->camera().camera->width(), 160);
+  // A camera section still replaces it.
+  writeSettings(dir / "settings.yaml", 64, 48);
+  EXPECT_EQ(openDataset(dir.path(), {dir / "settings.yaml", std::nullopt})->camera().camera->width(), 64);
+}
+
 TEST(EurocDataset, AppliesTheBodyToCameraTransformToGroundTruth) {
   testing::TempDir dir;
   synth::writeSequence(tiny(2), dir.path());
