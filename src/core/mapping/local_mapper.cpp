@@ -1,12 +1,12 @@
 #include "core/mapping/local_mapper.hpp"
 
-#include "core/geometry/skew.hpp"
-
 #include <cmath>
+#include <optional>
 #include <set>
 
 #include "core/features/hamming.hpp"
 #include "core/features/rotation_histogram.hpp"
+#include "core/geometry/skew.hpp"
 #include "core/geometry/triangulation.hpp"
 #include "core/mapping/keyframe_insertion.hpp"
 #include "core/matching/fusion.hpp"
@@ -38,23 +38,22 @@ void LocalMapper::process(const std::shared_ptr<Map>& map, const std::shared_ptr
   cullRecentPoints(*map, *kf);
   triangulateNewPoints(*map, *kf);
   fuse(*map, *kf);
-  if (map->keyframes.size() > 2) {
-    LocalBa ba = prepareLocalBa(*map, *kf);
+  // Maps of two keyframes (just initialized) have nothing for a local BA to hold fixed.
+  std::optional<LocalBa> ba;
+  if (map->keyframes.size() > 2) ba = prepareLocalBa(*map, *kf);
+  if (ba || before_ba) {
     lock.unlock();
     if (before_ba) before_ba();
-    BaOptions o;
-    o.iterations = settings_.local_ba_iterations;
-    o.abort = abort_ba;
-    ba.summary = bundleAdjust(ba.problem, o);
-    if (ba.summary.aborted) ++stats_.local_bas_cut_short;
+    if (ba) {
+      BaOptions o;
+      o.iterations = settings_.local_ba_iterations;
+      o.abort = abort_ba;
+      ba->summary = bundleAdjust(ba->problem, o);
+      if (ba->summary.aborted) ++stats_.local_bas_cut_short;
+    }
     lock.lock();
-    applyLocalBa(*map, ba);
-    if (map->merged_into.load()) return;  // merged during the BA: its keyframes live elsewhere
-  } else if (before_ba) {
-    lock.unlock();
-    before_ba();
-    lock.lock();
-    if (map->merged_into.load()) return;
+    if (ba) applyLocalBa(*map, *ba);
+    if (map->merged_into.load()) return;  // merged meanwhile: its keyframes live elsewhere
   }
   cullKeyframes(*map, *kf);
   ++stats_.keyframes_processed;
