@@ -9,7 +9,8 @@ namespace hiveslam::core {
 
 std::pair<Eigen::Isometry3d, double> KeyFrame::placement() const {
   // Down the anchors to a live keyframe, then back up: culled keyframes can chain (an anchor
-  // culled in turn), and a loop keeps this linear in the chain's length.
+  // culled in turn), and a loop keeps this linear in the chain's length. A live keyframe is
+  // its own end of the chain.
   std::vector<const KeyFrame*> chain;
   const KeyFrame* k = this;
   while (k->bad && k->anchor) {
@@ -30,12 +31,12 @@ std::pair<Eigen::Isometry3d, double> KeyFrame::placement() const {
 }
 
 RelativePose KeyFrame::relative(const Eigen::Isometry3d& T) const {
-  const auto [T_kw, s] = bad && anchor ? placement() : std::pair{T_cw, scale_change};
+  const auto [T_kw, s] = placement();
   return {T * T_kw.inverse(), s};
 }
 
 Eigen::Isometry3d KeyFrame::poseOf(const RelativePose& r) const {
-  const auto [T_kw, s] = bad && anchor ? placement() : std::pair{T_cw, scale_change};
+  const auto [T_kw, s] = placement();
   Eigen::Isometry3d T = r.T_c_k;
   T.translation() *= s / r.scale;
   return T * T_kw;
