@@ -53,7 +53,7 @@ double percentile(std::vector<double> v, double q) {
 void writeFrameLog(const std::filesystem::path& path, const std::vector<core::FrameRecord>& frames) {
   std::ofstream f(path);
   // reference: the keyframe the pose is kept relative to; reference_culled: it was erased
-  // later, and the pose follows it through its spanning-tree parent.
+  // later, and the pose follows it through its anchor (KeyFrame::pose).
   f << "index,timestamp,tracked,inliers,keyframe,tracking_ms,map,reference,reference_culled\n";
   for (const auto& r : frames)
     f << fmt::format("{},{:.6f},{},{},{},{:.3f},{},{},{}\n", r.index, r.timestamp, r.tracked ? 1 : 0, r.inliers,
