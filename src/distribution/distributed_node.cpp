@@ -30,7 +30,8 @@ DistributedNode::DistributedNode(core::SlamSystem& slam, communication::Transpor
         // TR's receiver (LM) has every point TR received from it; LM's (LC) those sent to it.
         if (topic == Topic::TrKeyframes) return observer_.hasPoint(point);
         return ledger_.sent(Topic::LmKeyframes, point) || ledger_.sent(Topic::LmMap, point);
-      });
+      },
+      [this](const core::Map& map) { return integrator_.label(map); });
   subscriber_ = std::make_unique<KeyframeSubscriber>(
       integrator_,
       [this](const StateIntegrator::Added& a, uint8_t target) {
@@ -46,10 +47,6 @@ DistributedNode::DistributedNode(core::SlamSystem& slam, communication::Transpor
       },
       [this](const Message& m) { onControl(m, Topic::TrKeyframes); });
   MapHandler::Hooks hooks;
-  hooks.stale = [this](const MapRecord& m) {
-    std::lock_guard lock(mutex_);
-    return m.epoch < knownEpoch(m.map);
-  };
   hooks.hold = [this](const MapRecord& m) {
     std::lock_guard lock(mutex_);
     if (m.epoch <= knownEpoch(m.map)) return false;
@@ -61,11 +58,6 @@ DistributedNode::DistributedNode(core::SlamSystem& slam, communication::Transpor
     return true;
   };
   hooks.global = [this](std::vector<MapRecord>&& b, Topic t) { onGlobal(std::move(b), t); };
-  hooks.epoch = [this](core::Id map) {
-    std::lock_guard lock(mutex_);
-    auto it = synced_.find(map);
-    return it == synced_.end() ? uint64_t{0} : it->second;
-  };
   hooks.local_applied = [this](const MapRecord& m) {
     {
       std::lock_guard lock(mutex_);
@@ -215,12 +207,19 @@ void DistributedNode::globalUpdate(const core::GlobalUpdate& u) {
   std::vector<core::Id> merged;
   if (u.merged_map != core::kNoId) merged.push_back(u.merged_map);
   std::lock_guard lock(mutex_);
+  // The map is in this epoch's frame from now on, for what this node sends and what it takes.
+  const auto note = [&](uint64_t e) {
+    std::lock_guard map_lock(map->mutex);
+    integrator_.noteEpoch(*map, e);
+  };
   if (options_.task == Task::LoopClosing) {
     const uint64_t e = std::max(published_[u.map], synced_[u.map]) + 1;
     published_[u.map] = synced_[u.map] = e;
+    note(e);
     handler_->sendGlobal(map, e, Topic::LcMap, merged);
   } else if (plan_.local_maps && !peers_.empty()) {
     const uint64_t e = ++synced_[u.map];
+    note(e);
     handler_->sendGlobal(map, e, Topic::LmMap, merged);
   }
 }
@@ -255,7 +254,7 @@ void DistributedNode::onGlobal(std::vector<MapRecord>&& batches, Topic topic) {
   }
   if (ignore) {
     // Still, what is new here (points LM made) and what LM erased is taken.
-    for (const auto& b : batches) integrator_.applyLocal(b, true);
+    for (const auto& b : batches) integrator_.applyLocal(b);  // labelled older: stale here
     return;
   }
   integrator_.applyGlobal(batches, true);
@@ -275,20 +274,20 @@ uint64_t DistributedNode::knownEpoch(core::Id map) const {
 
 void DistributedNode::releaseHeld(core::Id map) {
   // Runs on the map handler's thread, like every other apply: arrival order is kept.
-  std::vector<std::pair<MapRecord, bool>> ready;  // (local map, stale)
+  std::vector<MapRecord> ready;
   {
     std::lock_guard lock(mutex_);
     const uint64_t now = knownEpoch(map);
     for (auto it = held_.begin(); it != held_.end();) {
       if (it->map == map && it->epoch <= now) {
-        ready.emplace_back(std::move(*it), it->epoch < now);
+        ready.push_back(std::move(*it));
         it = held_.erase(it);
       } else {
         ++it;
       }
     }
   }
-  for (const auto& [m, stale] : ready) integrator_.applyLocal(m, stale);
+  for (const auto& m : ready) integrator_.applyLocal(m);
 }
 
 void DistributedNode::onControl(const Message& m, Topic topic) {
@@ -436,6 +435,7 @@ nlohmann::json DistributedNode::report(double seconds) const {
     std::lock_guard lock(mutex_);
     j["globals_ignored"] = globals_ignored_;
     j["local_maps_held"] = local_maps_held_;
+    j["stale_points_carried"] = integrator_.stalePointsCarried();
     j["peers"] = peers_.size();
   }
   j["s_full_keyframes"] = observer_.keyframeCount();

@@ -11,8 +11,13 @@
 namespace hiveslam::distribution {
 
 KeyframePublisher::KeyframePublisher(communication::Transport& transport, Observer& observer, SentLedger& ledger,
-                                     uint16_t node, Known known)
-    : transport_(transport), observer_(observer), ledger_(ledger), node_(node), known_(std::move(known)) {
+                                     uint16_t node, Known known, Label label)
+    : transport_(transport),
+      observer_(observer),
+      ledger_(ledger),
+      node_(node),
+      known_(std::move(known)),
+      label_(std::move(label)) {
   thread_ = std::thread([this] {
     nameThisThread("kf-publisher");
     loop();
@@ -42,11 +47,11 @@ void KeyframePublisher::publish(const Job& job) {
     return;
   }
   KeyFrameMessage m;
-  uint64_t epoch = 0;
+  uint64_t label = 0;
   {
     std::lock_guard lock(job.map->mutex);
     const core::KeyFrame& kf = *job.keyframe;
-    epoch = job.map->epoch;
+    label = label_ ? label_(*job.map) : 0;
     m.keyframe = captureKeyframe(kf, job.map->id, true);
     std::vector<const core::KeyFrame*> with_points{&kf};
     // A new map's first keyframe travels with its second (the receiver builds the map from them).
@@ -82,7 +87,7 @@ void KeyframePublisher::publish(const Job& job) {
   }
   observer_.record(m.keyframe);
   for (const auto& p : m.points) observer_.record(p);
-  transport_.publish(job.topic, pack(m, node_, job.target, job.map->id, epoch));
+  transport_.publish(job.topic, pack(m, node_, job.target, job.map->id, label));
   ++published_;
 }
 

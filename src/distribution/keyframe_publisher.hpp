@@ -26,8 +26,11 @@ class KeyframePublisher {
   };
   // known(point): the receivers of `topic` already have the point.
   using Known = std::function<bool(communication::Topic, core::Id)>;
+  // label(map), with the map's mutex held: the global epoch of the map's current frame. A
+  // keyframe goes out labelled with it (StateIntegrator).
+  using Label = std::function<uint64_t(const core::Map&)>;
   KeyframePublisher(communication::Transport& transport, Observer& observer, SentLedger& ledger, uint16_t node,
-                    Known known);
+                    Known known, Label label);
   ~KeyframePublisher();
   void push(Job job) { queue_.push(std::move(job)); }
   // Sends what is queued, then stops the thread.
@@ -42,6 +45,7 @@ class KeyframePublisher {
   SentLedger& ledger_;
   uint16_t node_;
   Known known_;
+  Label label_;
   BlockingQueue<Job> queue_;
   std::atomic<int> published_{0};
   std::unordered_map<core::Id, bool> maps_started_;  // publisher thread only

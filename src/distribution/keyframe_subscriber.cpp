@@ -31,7 +31,7 @@ void KeyframeSubscriber::loop() {
     try {
       const KeyFrameMessage k = decodeKeyframe(unpack(*m, PacketKind::Keyframe));
       ++received_;
-      auto added = integrator_.addKeyframe(k);
+      auto added = integrator_.addKeyframe(k, m->epoch);
       if (added.keyframe) route_(added, m->target);
     } catch (const std::exception& e) {
       ++dropped_;

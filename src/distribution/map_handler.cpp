@@ -260,9 +260,9 @@ void MapHandler::sendLocalBatch(Outgoing& o) {
   MapRecord m;
   m.kind = MapRecord::Kind::Local;
   m.map = map.id;
-  m.epoch = hooks_.epoch ? hooks_.epoch(map.id) : 0;
   {
     std::lock_guard lock(map.mutex);
+    m.epoch = integrator_.label(map);
     if (map.merged_into.load()) {
       o.dirty_points.clear();
       return;
@@ -383,7 +383,7 @@ void MapHandler::handleIncoming(communication::Message& msg, Topic topic) {
         if (hooks_.local_applied) hooks_.local_applied(m);
         return;
       }
-      integrator_.applyLocal(m, hooks_.stale && hooks_.stale(m));
+      integrator_.applyLocal(m);
       if (hooks_.local_applied) hooks_.local_applied(m);
     } else if (auto all = observer_.collectGlobal(std::move(m))) {
       if (hooks_.global) hooks_.global(std::move(*all), topic);

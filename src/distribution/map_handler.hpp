@@ -26,16 +26,12 @@ namespace hiveslam::distribution {
 class MapHandler {
  public:
   struct Hooks {
-    // Incoming local map: whether it predates this node's latest global update of the map.
-    std::function<bool(const MapRecord&)> stale;
     // Incoming local map from a newer epoch than this node has applied (its sender took a
     // global update that is still on its way here): the hook keeps it and returns true. Its
     // poses are in the new frame; applied now, the global update would correct them twice.
     std::function<bool(const MapRecord&)> hold;
     // Incoming global map, complete (all batches), from `topic`.
     std::function<void(std::vector<MapRecord>&&, communication::Topic)> global;
-    // Epoch written into outgoing local maps of a map.
-    std::function<uint64_t(core::Id)> epoch;
     std::function<void(const MapRecord&)> local_applied;
     // A control packet, in order with the maps of its topic.
     std::function<void(const communication::Message&, communication::Topic)> control;

@@ -18,7 +18,9 @@ KeyFrameRecord captureKeyframe(const core::KeyFrame& kf, Id map, bool full) {
     r.frame = kf.frame;
     r.made_in_epoch = kf.made_in_epoch;
     r.made_from = kf.made_from ? kf.made_from->id : kNoId;
-    r.T_made_from = kf.T_made_from;
+    // In the map's current frame (the label's): the scale it was taken at is this node's own.
+    r.T_made_from = kf.made_pose.T_c_k;
+    if (kf.made_from) r.T_made_from.translation() *= kf.made_from->scale() / kf.made_pose.scale;
   }
   return r;
 }

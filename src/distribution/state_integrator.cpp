@@ -125,11 +125,46 @@ std::shared_ptr<core::KeyFrame> StateIntegrator::makeKeyframe(const KeyFrameReco
   auto kf = std::make_shared<core::KeyFrame>(r.id, r.frame, r.T_cw);
   if (const auto* v = slam_.vocabulary(); v && !v->empty()) v->transform(kf->frame.descriptors, kf->bow, kf->bow_features);
   kf->made_in_epoch = r.made_in_epoch;
-  kf->T_made_from = r.T_made_from;
+  kf->made_pose.T_c_k = r.T_made_from;  // its scale, this node's, is set once the map is locked
   return kf;
 }
 
-StateIntegrator::Added StateIntegrator::addKeyframe(const KeyFrameMessage& m) {
+void StateIntegrator::noteEpoch(const core::Map& map, uint64_t label) {
+  Frame f;
+  f.core_epoch = map.epoch;
+  f.scales.reserve(map.keyframes.size());
+  for (const auto& [id, kf] : map.keyframes) f.scales.emplace(id, kf->scale());
+  for (const auto& kf : map.retired) f.scales.emplace(kf->id, kf->scale());  // tracking posed some from these
+  std::lock_guard lock(epochs_mutex_);
+  auto& frames = epochs_[map.id];
+  frames[label] = std::move(f);
+  // Content older than a few global updates is not expected: its sender would be that far
+  // behind, and the 3 kept are a second or more of updates.
+  while (frames.size() > 3) frames.erase(frames.begin());
+}
+
+const StateIntegrator::Frame* StateIntegrator::frameOf(const core::Map& map, uint64_t label) const {
+  auto it = epochs_.find(map.id);
+  if (it == epochs_.end()) return nullptr;
+  auto f = it->second.find(label);
+  return f == it->second.end() ? nullptr : &f->second;
+}
+
+uint64_t StateIntegrator::label(const core::Map& map) const {
+  std::lock_guard lock(epochs_mutex_);
+  auto it = epochs_.find(map.id);
+  return it == epochs_.end() || it->second.empty() ? 0 : it->second.rbegin()->first;
+}
+
+bool StateIntegrator::stale(const core::Map& map, uint64_t label) const {
+  std::lock_guard lock(epochs_mutex_);
+  if (const Frame* f = frameOf(map, label)) return f->core_epoch != map.epoch;
+  // Before any global map, every node holds the map in the frame it was made in (core epoch
+  // 0 everywhere). Any other unknown label is ahead of this node (held back by the caller).
+  return label == 0 && map.epoch != 0;
+}
+
+StateIntegrator::Added StateIntegrator::addKeyframe(const KeyFrameMessage& m, uint64_t label) {
   Added out;
   auto map = mapFor(m.keyframe.map);
   if (!map) return out;
@@ -137,10 +172,46 @@ StateIntegrator::Added StateIntegrator::addKeyframe(const KeyFrameMessage& m) {
   std::vector<std::shared_ptr<core::KeyFrame>> companions;
   for (const auto& c : m.companions) companions.push_back(makeKeyframe(c));
   auto kf = makeKeyframe(m.keyframe);
+  std::vector<PointRecord> applied;  // as they went into the map, for S_full
+  applied.reserve(m.points.size());
   {
     std::lock_guard lock(map->mutex);
     if (map->keyframes.count(kf->id)) return out;
-    for (const auto& p : m.points) applyPoint(*map, p);
+    if (m.keyframe.made_from != kNoId)
+      if (auto it = map->keyframes.find(m.keyframe.made_from); it != map->keyframes.end())
+        kf->made_from = it->second.get();
+    // Whether it missed a correction is told by its label, not by the core's epoch counter it
+    // was made with, which counts differently on each node; from here on the core's counter
+    // tells whether it waits in this node's queue through one.
+    kf->made_in_epoch = map->epoch;
+    if (kf->made_from) kf->made_pose.scale = kf->made_from->scale();  // the record's is the label's frame
+    if (stale(*map, label)) {
+      if (kf->made_from) {
+        // The correction may have rescaled the map around the keyframe it was posed from.
+        double then = 1.0;
+        {
+          std::lock_guard epochs(epochs_mutex_);
+          if (const Frame* f = frameOf(*map, label))
+            if (auto s = f->scales.find(kf->made_from->id); s != f->scales.end()) then = s->second;
+        }
+        const double change = kf->made_from->scale() / then;
+        kf->T_cw = kf->made_from->poseOf({kf->made_pose.T_c_k, then});
+        kf->made_pose = kf->made_from->relative(kf->T_cw);
+        for (auto p : m.points)
+          if (!map->points.count(p.id)) {
+            // The same point seen from the keyframe, in the current frame and scale.
+            p.position = kf->T_cw.inverse() * (change * (m.keyframe.T_cw * p.position));
+            applyPoint(*map, p);
+            applied.push_back(p);
+            ++stale_points_carried_;
+          }
+      }
+      // else: nothing to carry it by; its new points wait for a fresh record, and the
+      // keyframe's pose for the sender's next local map.
+    } else {
+      for (const auto& p : m.points) applyPoint(*map, p);
+      applied = m.points;
+    }
     for (size_t i = 0; i < companions.size(); ++i) {
       auto& c = companions[i];
       if (map->keyframes.count(c->id)) continue;
@@ -149,9 +220,6 @@ StateIntegrator::Added StateIntegrator::addKeyframe(const KeyFrameMessage& m) {
       relink(*map, *c, m.companions[i]);
       if (!map->origin) map->origin = c.get();
     }
-    if (m.keyframe.made_from != kNoId)
-      if (auto it = map->keyframes.find(m.keyframe.made_from); it != map->keyframes.end())
-        kf->made_from = it->second.get();
     // Links as the sender had them; local mapping's insertion makes the observations.
     for (const auto& [i, pid] : m.keyframe.matches)
       if (auto it = map->points.find(pid); it != map->points.end() && i < kf->points.size()) kf->points[i] = it->second;
@@ -163,23 +231,67 @@ StateIntegrator::Added StateIntegrator::addKeyframe(const KeyFrameMessage& m) {
         it->second->found = std::max(it->second->found, static_cast<int>(s.found));
       }
   }
-  for (const auto& p : m.points) observer_.record(p);
+  for (const auto& p : applied) observer_.record(p);
   for (const auto& c : m.companions) observer_.record(c);
-  observer_.record(m.keyframe);
+  KeyFrameRecord placed = m.keyframe;
+  placed.T_cw = kf->T_cw;
+  observer_.record(placed);
   out.map = map;
   out.keyframe = kf;
   return out;
 }
 
-void StateIntegrator::applyLocal(const MapRecord& m, bool stale) {
+bool StateIntegrator::carryStalePoint(core::Map& map, const MapRecord& m, PointRecord& p) {
+  // The point was triangulated in the coordinate frame the sender had before it applied this
+  // node's latest global map, like the window keyframes' poses in the same record. Carried
+  // through a window keyframe this node holds: the one that made the point, else any other.
+  const KeyFrameRecord* via = nullptr;
+  core::KeyFrame* here = nullptr;
+  for (const auto& k : m.keyframes) {
+    auto it = map.keyframes.find(k.id);
+    if (it == map.keyframes.end()) continue;
+    if (!via || k.id == p.first_keyframe) {
+      via = &k;
+      here = it->second.get();
+    }
+    if (k.id == p.first_keyframe) break;
+  }
+  if (!here) return false;
+  // The correction may have rescaled the map around that keyframe: how far the record's other
+  // points are from it here, against in the record (as core::applyCorrection measures it).
+  std::unordered_map<Id, const Eigen::Vector3d*> recorded;
+  for (const auto& q : m.points) recorded.emplace(q.id, &q.position);
+  const Eigen::Isometry3d T_here = here->pose();
+  std::vector<double> ratios;
+  for (const auto& q : here->points) {
+    if (!q || q->bad) continue;
+    auto it = recorded.find(q->id);
+    if (it == recorded.end()) continue;
+    const double was = (via->T_cw * *it->second).norm(), is = (T_here * q->position).norm();
+    if (was > 1e-9 && is > 1e-9) ratios.push_back(is / was);
+  }
+  double s = 1.0;
+  if (ratios.size() >= 8) {
+    auto mid = ratios.begin() + static_cast<std::ptrdiff_t>(ratios.size() / 2);
+    std::nth_element(ratios.begin(), mid, ratios.end());
+    s = *mid;
+  }
+  p.position = T_here.inverse() * (s * (via->T_cw * p.position));
+  ++stale_points_carried_;
+  return true;
+}
+
+void StateIntegrator::applyLocal(const MapRecord& m) {
   auto map = slam_.findMap(m.map);
   if (!map || map->merged_into.load()) return;
   std::lock_guard lock(map->mutex);
-  if (stale) {
+  if (stale(*map, m.epoch)) {
     for (const auto& p : m.points)
       if (!map->points.count(p.id)) {
-        applyPoint(*map, p);
-        observer_.record(p);
+        PointRecord carried = p;
+        if (!carryStalePoint(*map, m, carried)) continue;  // its next fresh record brings it
+        applyPoint(*map, carried);
+        observer_.record(carried);
       }
     applyErasures(*map, m);
     for (Id id : m.erased_keyframes) observer_.eraseKeyframe(id);
@@ -276,6 +388,7 @@ void StateIntegrator::applyGlobal(const std::vector<MapRecord>& batches, bool au
     observer_.prune(kfs, pts, [&](Id id) { return olderThanSnapshot(id, newest_kf) || olderThanSnapshot(id, newest_point); });
   }
   for (const auto& [id, k] : map->keyframes) k->updateConnections();
+  noteEpoch(*map, batches.front().epoch);
 }
 
 }  // namespace hiveslam::distribution

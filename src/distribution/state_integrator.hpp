@@ -5,7 +5,18 @@
 // Epochs (docs/ARCHITECTURE.md): a global map is applied only when all its batches are in, as
 // one correction (core::applyCorrection): keyframes and points it does not cover move with
 // their spanning-tree ancestors, so no map ever holds keyframes in two coordinate frames.
+//
+// Every keyframe and local map travels labelled with its sender's global epoch of the map: the
+// coordinate frame its poses and points are in. Each node notes, under the map's mutex, which
+// of its own core epochs (core::Map::epoch, a count that differs from node to node) each label
+// stands for. Content whose label no longer stands for the map's current frame is stale: it
+// is carried into the current frame. Deciding that under the same lock as the correction
+// leaves no window in which a correction is applied but not yet known.
+#include <atomic>
+#include <map>
 #include <memory>
+#include <mutex>
+#include <unordered_map>
 
 #include "core/system/slam_system.hpp"
 #include "distribution/observer.hpp"
@@ -17,18 +28,28 @@ class StateIntegrator {
   StateIntegrator(core::SlamSystem& slam, Observer& observer) : slam_(slam), observer_(observer) {}
 
   // A new keyframe (with its new points and, for a new map, its first keyframe). Returns the
-  // core keyframe and its map, not yet given to a module; null when it is already known.
+  // core keyframe and its map, not yet given to a module; null when it is already known. One
+  // labelled with an older frame is re-posed from where tracking posed it (relative to a
+  // keyframe both nodes hold), and the points it brings move with it.
   struct Added {
     std::shared_ptr<core::Map> map;
     std::shared_ptr<core::KeyFrame> keyframe;
   };
-  Added addKeyframe(const KeyFrameMessage& m);
-  // `stale`: computed before the sender applied this node's latest global map; only what is new
-  // here (points, erasures) is taken, the rest is in the old coordinate frame.
-  void applyLocal(const MapRecord& m, bool stale = false);
+  Added addKeyframe(const KeyFrameMessage& m, uint64_t label);
+  // A local map labelled with an older frame than the map's (the sender computed it before it
+  // applied this node's latest global map): only what is new here (points, erasures) is taken,
+  // the points carried into the current frame; the poses are left to a fresh record.
+  void applyLocal(const MapRecord& m);
   // All batches of one global map. `authoritative`: the sender's map is the reference (LM's
   // relay): objects missing from it are erased here.
   void applyGlobal(const std::vector<MapRecord>& batches, bool authoritative);
+  uint64_t stalePointsCarried() const { return stale_points_carried_; }
+
+  // With the map's mutex held: the map is now in the frame of global epoch `label` (a global
+  // map applied here, or made here and published as that epoch).
+  void noteEpoch(const core::Map& map, uint64_t label);
+  // With the map's mutex held: the label of the map's current frame, for outgoing content.
+  uint64_t label(const core::Map& map) const;
 
  private:
   std::shared_ptr<core::Map> mapFor(Id id);
@@ -37,9 +58,26 @@ class StateIntegrator {
   // True when the keyframe's point links changed.
   bool relink(core::Map& map, core::KeyFrame& kf, const KeyFrameRecord& r);
   void applyErasures(core::Map& map, const MapRecord& m);
+  // A new point of a stale local map, moved into this node's coordinate frame; false when no
+  // keyframe of the record is here to carry it.
+  bool carryStalePoint(core::Map& map, const MapRecord& m, PointRecord& p);
   std::shared_ptr<core::KeyFrame> makeKeyframe(const KeyFrameRecord& r) const;
+  // With the map's mutex held: content labelled `label` is in an older frame than the map's.
+  bool stale(const core::Map& map, uint64_t label) const;
   core::SlamSystem& slam_;
   Observer& observer_;
+  std::atomic<uint64_t> stale_points_carried_{0};
+  // What a label stood for here: the core epoch, and each keyframe's scale() then (content of
+  // that frame is rescaled by how much the map's scale changed around it since).
+  struct Frame {
+    uint64_t core_epoch = 0;
+    std::unordered_map<Id, double> scales;
+  };
+  // With the map's mutex held: the frame `label` stood for here; null when unknown.
+  const Frame* frameOf(const core::Map& map, uint64_t label) const;  // epochs_mutex_ held
+  // Per map, the last few labels. Taken after a map's mutex.
+  mutable std::mutex epochs_mutex_;
+  std::unordered_map<Id, std::map<uint64_t, Frame>> epochs_;
 };
 
 }  // namespace hiveslam::distribution

@@ -52,6 +52,33 @@ TEST(Sim3Solver, RansacRecoversAKnownSimilarityDespiteOutliers) {
   EXPECT_NEAR(S.s, truth.s, 0.02);
   EXPECT_LT((S.t - truth.t).norm(), 0.03);
   EXPECT_LT(S.q.angularDistance(truth.q), 0.005);
+  EXPECT_NEAR(pointScale(matches, S, inlier), truth.s, 0.01);
+}
+
+// A place seen again from where it was seen before: the cameras stand together, and every
+// scale projects the same. The refinement cannot find it; the points can.
+TEST(Sim3Solver, ThePointsTellTheScaleWhereTheReprojectionsCannot) {
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> u(-1, 1);
+  const Intrinsics K{450, 450, 376, 240};
+  const Sim3 truth(Eigen::Quaterniond(Eigen::AngleAxisd(0.05, Eigen::Vector3d::UnitY())), Eigen::Vector3d::Zero(), 1.03);
+  std::vector<Sim3Match> matches;
+  for (int i = 0; i < 100; ++i) {
+    Sim3Match m;
+    m.p2 = Eigen::Vector3d(1.5 * u(rng), u(rng), 3 + u(rng));
+    m.p1 = truth * m.p2;
+    m.uv1 = K.project(m.p1);
+    m.uv2 = K.project(m.p2);
+    m.p1 *= 1 + 0.01 * u(rng);
+    m.p2 *= 1 + 0.01 * u(rng);
+    matches.push_back(m);
+  }
+  Sim3 S = truth;
+  S.s = 1.12;  // where a refinement can wander off to
+  std::vector<bool> inlier(matches.size(), true);
+  EXPECT_EQ(refineSim3(K, K, matches, S, inlier), 100);
+  EXPECT_GT(std::abs(S.s - truth.s), 0.05) << "the reprojections pinned the scale after all";
+  EXPECT_NEAR(pointScale(matches, S, inlier), truth.s, 0.005);
 }
 
 TEST(Sim3Solver, RefusesMatchesWithoutACommonSimilarity) {

@@ -37,4 +37,10 @@ Sim3Result solveSim3Ransac(const Intrinsics& K1, const Intrinsics& K2, const std
 // Inlier test of one match under S12 (reprojection in both images).
 bool sim3Inlier(const Intrinsics& K1, const Intrinsics& K2, const Sim3Match& m, const Sim3& S12, double chi2);
 
+// The scale the matched points themselves show under S12's rotation and translation: the
+// median over the inliers of each point's ratio along its ray (p1 - t) . R p2 / |R p2|^2.
+// Reprojections alone cannot tell it when the two cameras stand close together (a place seen
+// again from where it was seen before): x -> s R x projects the same for every s.
+double pointScale(const std::vector<Sim3Match>& matches, const Sim3& S12, const std::vector<bool>& inlier);
+
 }  // namespace hiveslam::core

@@ -155,8 +155,14 @@ bool LoopCloser::verify(KeyFrame& kf, KeyFrame& place, Verified& out) const {
     kf_index.push_back(i);
     inlier.push_back(true);
   }
+  // Rotation and translation from the images; the scale from the points. Where the keyframe
+  // stands close to where the place was seen from (a revisit welded late, as at LC while a
+  // correction is still on its way to tracking), the reprojections leave the scale free and the
+  // refinement wandered to 0.94-1.13 while the points said 0.998-1.011.
   Sim3 S = r.S12;
-  const int inliers = refineSim3(kf.frame.K, place.frame.K, matches, S, inlier);
+  refineSim3(kf.frame.K, place.frame.K, matches, S, inlier);
+  S.s = pointScale(matches, S, inlier);
+  const int inliers = refineSim3(kf.frame.K, place.frame.K, matches, S, inlier, true);
   // A true place explains most of the guided matches too; a look-alike (a repeated texture seen
   // from elsewhere) gives a Sim3 that only a minority of them agree with.
   if (inliers < settings_.loop_min_sim3_inliers ||
@@ -334,7 +340,13 @@ LoopCloser::LoopCorrection LoopCloser::correctLoop(Map& map, KeyFrame& kf, const
     for (const auto& p : k->points)
       if (p && !p->bad && moved.insert(p.get()).second)
         p->position = c.corrected[k].inverse() * (c.uncorrected[k] * p->position);
-  for (KeyFrame* k : connected) k->T_cw = c.corrected[k].toPose();
+  for (KeyFrame* k : connected) {
+    k->T_cw = c.corrected[k].toPose();
+    // Its points were scaled by the loop's Sim3 around it: what is held relative to it (culled
+    // keyframes, keyframes and tracked frames posed from it) must be too. The essential graph
+    // starts from these corrected poses and adds only its own change.
+    k->scale_change /= c.corrected[k].s;
+  }
   for (MapPoint* p : moved) p->update(scales_);
   // Fuse the place's points into the corrected side, then see which new links that made.
   std::map<KeyFrame*, std::set<KeyFrame*, ById>, ById> before;

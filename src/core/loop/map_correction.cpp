@@ -42,7 +42,9 @@ void applyCorrection(Map& map, const PoseCorrection& c, const std::vector<double
     KeyFrame* k = kf;
     while (k && !moves.count(k)) {
       chain.push_back(k);
-      k = k->parent;
+      // A keyframe tracking has just made has no parent until local mapping gives it one
+      // (at TR, until a local map says which): it moves with the keyframe it was posed from.
+      k = k->bad && k->anchor ? k->anchor : k->parent ? k->parent : k->made_from;
       if (chain.size() > 100000) break;  // a broken tree must not hang us
     }
     const Sim3 C = k ? moves.at(k) : Sim3();

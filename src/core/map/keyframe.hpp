@@ -55,7 +55,7 @@ class KeyFrame : public std::enable_shared_from_this<KeyFrame> {
   // keyframe. A keyframe that waited in the queue through a correction is re-posed from these.
   uint64_t made_in_epoch = 0;
   KeyFrame* made_from = nullptr;
-  Eigen::Isometry3d T_made_from = Eigen::Isometry3d::Identity();
+  RelativePose made_pose;
   // The current pose and scale change: a live keyframe's own, a culled one's through its anchor.
   Eigen::Isometry3d pose() const { return bad && anchor ? placement().first : T_cw; }
   double scale() const { return bad && anchor ? placement().second : scale_change; }

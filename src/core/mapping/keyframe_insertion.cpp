@@ -5,7 +5,7 @@ namespace hiveslam::core {
 void insertKeyframe(Map& map, KeyFrame& kf, const std::vector<double>& scales, KeyframeDatabase* database) {
   // The map moved (loop correction, global BA) while this keyframe waited in a queue: it moves
   // with the keyframe tracking posed it against.
-  if (kf.made_in_epoch != map.epoch && kf.made_from) kf.T_cw = kf.T_made_from * kf.made_from->pose();
+  if (kf.made_in_epoch != map.epoch && kf.made_from) kf.T_cw = kf.made_from->poseOf(kf.made_pose);
   kf.made_in_epoch = map.epoch;
   if (!map.keyframes.count(kf.id)) {
     map.add(kf.shared_from_this());

@@ -432,7 +432,7 @@ std::shared_ptr<KeyFrame> Tracker::makeKeyframe(const Tracked& c) {
   kf->made_in_epoch = map_->epoch;
   if (reference_) {
     kf->made_from = reference_.get();
-    kf->T_made_from = c.T_cw * reference_->pose().inverse();
+    kf->made_pose = reference_->relative(c.T_cw);
   }
   for (size_t i = 0; i < c.points.size(); ++i)
     if (c.points[i] && !c.outlier[i] && !c.points[i]->bad) kf->points[i] = c.points[i];

@@ -1,0 +1,207 @@
+// A local map or a keyframe that its sender made before it applied this node's latest global
+// map comes in the old coordinate frame (its label says which). Its new points must land where
+// the correction would have put them: a point left at its old position sits centimetres off in
+// a map a loop closure just moved, and the next loop search matches it with a wrong scale.
+#include <gtest/gtest.h>
+
+#include "core/camera/pinhole_radtan.hpp"
+#include "core/mapping/keyframe_insertion.hpp"
+#include "core/system/slam_system.hpp"
+#include "distribution/state_integrator.hpp"
+
+namespace hiveslam::distribution {
+namespace {
+
+constexpr Id kMap = 7, kFirst = 11, kSecond = 12, kNewPoint = 500;
+constexpr int kPoints = 30;
+
+core::Frame featureFrame(size_t n) {
+  core::Frame f;
+  f.keypoints.assign(n, cv::KeyPoint(100.f, 100.f, 31.f));
+  f.points.assign(n, Eigen::Vector2d(100, 100));
+  f.descriptors = cv::Mat::zeros(static_cast<int>(n), 32, CV_8U);
+  f.K = {400, 400, 320, 240};
+  f.width = 640;
+  f.height = 480;
+  f.buildGrid();
+  return f;
+}
+
+Eigen::Isometry3d poseAt(double x) {
+  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+  T.linear() = Eigen::AngleAxisd(0.1 * x, Eigen::Vector3d::UnitY()).toRotationMatrix();
+  T.translation() = Eigen::Vector3d(-x, 0.1, 0);
+  return T;
+}
+
+Eigen::Vector3d pointAt(int i) { return {-1.0 + 0.07 * i, 0.3 * std::sin(i), 3.0 + 0.05 * i}; }
+
+// The pose that sees the world moved by S as T saw it, the map scaled by S.s around it.
+Eigen::Isometry3d moved(const Eigen::Isometry3d& T, const core::Sim3& S) {
+  return (core::Sim3(Eigen::Quaterniond::Identity(), Eigen::Vector3d::Zero(), S.s) * core::Sim3(T) * S.inverse())
+      .toPose();
+}
+
+class EpochLabels : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    for (Id kf : {kFirst, kSecond}) {
+      KeyFrameMessage m;
+      m.keyframe.id = kf;
+      m.keyframe.map = kMap;
+      m.keyframe.full = true;
+      m.keyframe.frame = featureFrame(kPoints + 1);
+      m.keyframe.T_cw = poseAt(kf == kFirst ? 0.0 : 0.4);
+      if (kf == kSecond) m.keyframe.parent = kFirst;
+      for (int i = 0; i < kPoints; ++i) {
+        m.keyframe.matches.emplace_back(i, 100 + i);
+        if (kf == kFirst) {
+          PointRecord p;
+          p.id = 100 + i;
+          p.position = pointAt(i);
+          p.full = true;
+          p.first_keyframe = kFirst;
+          m.points.push_back(p);
+        }
+      }
+      const auto added = integrator_.addKeyframe(m, 0);
+      ASSERT_TRUE(added.keyframe);
+      std::lock_guard lock(added.map->mutex);
+      core::insertKeyframe(*added.map, *added.keyframe, slam_.scales(), &slam_.database());
+    }
+  }
+
+  // The loop closure: the whole map moves by S (the global map of epoch 1).
+  void correct(const core::Sim3& S) {
+    MapRecord g;
+    g.kind = MapRecord::Kind::Global;
+    g.map = kMap;
+    g.epoch = 1;
+    for (Id kf : {kFirst, kSecond}) {
+      KeyFrameRecord k;
+      k.id = kf;
+      k.map = kMap;
+      k.links = false;
+      k.T_cw = moved(poseAt(kf == kFirst ? 0.0 : 0.4), S);
+      g.keyframes.push_back(k);
+    }
+    for (int i = 0; i < kPoints; ++i) {
+      PointRecord p;
+      p.id = 100 + i;
+      p.position = S * pointAt(i);
+      g.points.push_back(p);
+    }
+    integrator_.applyGlobal({g}, false);
+  }
+
+  // LM's local map of epoch 0: the window as it was, and one new point, all in the old frame.
+  MapRecord staleLocalMap(const Eigen::Vector3d& new_point, bool with_keyframes = true) const {
+    MapRecord m;
+    m.map = kMap;
+    m.epoch = 0;
+    if (with_keyframes)
+      for (Id kf : {kFirst, kSecond}) {
+        KeyFrameRecord k;
+        k.id = kf;
+        k.map = kMap;
+        k.links = false;
+        k.T_cw = poseAt(kf == kFirst ? 0.0 : 0.4);
+        m.keyframes.push_back(k);
+      }
+    for (int i = 0; i < kPoints; ++i) {
+      PointRecord p;
+      p.id = 100 + i;
+      p.position = pointAt(i);
+      m.points.push_back(p);
+    }
+    PointRecord p;
+    p.id = kNewPoint;
+    p.position = new_point;
+    p.full = true;
+    p.first_keyframe = kSecond;
+    m.points.push_back(p);
+    return m;
+  }
+
+  std::optional<Eigen::Vector3d> pointHere(Id id) {
+    auto map = slam_.findMap(kMap);
+    std::lock_guard lock(map->mutex);
+    auto it = map->points.find(id);
+    if (it == map->points.end()) return std::nullopt;
+    return it->second->position;
+  }
+
+  core::SlamSystem slam_{core::SlamSettings{},
+                         std::make_shared<camera::PinholeRadTan>(640, 480, 400, 400, 320, 240),
+                         core::SlamSystem::Mode::Offline};
+  Observer observer_;
+  StateIntegrator integrator_{slam_, observer_};
+};
+
+TEST_F(EpochLabels, NewPointsFollowTheCorrectionScaleIncluded) {
+  const core::Sim3 S(Eigen::Quaterniond(Eigen::AngleAxisd(0.3, Eigen::Vector3d::UnitZ())), {2.0, -1.0, 0.5}, 1.2);
+  correct(S);
+  ASSERT_LT((*pointHere(100) - S * pointAt(0)).norm(), 1e-9);  // the correction itself landed
+
+  const Eigen::Vector3d q(0.2, -0.1, 4.0);
+  integrator_.applyLocal(staleLocalMap(q));
+  const auto here = pointHere(kNewPoint);
+  ASSERT_TRUE(here);
+  EXPECT_LT((*here - S * q).norm(), 1e-9) << "at " << here->transpose() << ", expected " << (S * q).transpose();
+  EXPECT_EQ(integrator_.stalePointsCarried(), 1u);
+  // The points this node already had keep their corrected positions.
+  EXPECT_LT((*pointHere(105) - S * pointAt(5)).norm(), 1e-9);
+}
+
+TEST_F(EpochLabels, AFreshLocalMapIsTakenAsItIs) {
+  const core::Sim3 S(Eigen::Quaterniond::Identity(), {1.0, 0, 0}, 1.1);
+  correct(S);
+  {
+    auto map = slam_.findMap(kMap);
+    std::lock_guard lock(map->mutex);
+    EXPECT_EQ(integrator_.label(*map), 1u);  // what this node's own records now carry
+  }
+  MapRecord m = staleLocalMap({0.2, -0.1, 4.0});
+  m.epoch = 1;  // made after the sender applied the same correction: already in the new frame
+  integrator_.applyLocal(m);
+  EXPECT_LT((*pointHere(kNewPoint) - Eigen::Vector3d(0.2, -0.1, 4.0)).norm(), 1e-12);
+  EXPECT_EQ(integrator_.stalePointsCarried(), 0u);
+}
+
+TEST_F(EpochLabels, AKeyframeMadeBeforeTheCorrectionIsRePosedWithItsPointsScaleIncluded) {
+  const core::Sim3 S(Eigen::Quaterniond(Eigen::AngleAxisd(0.2, Eigen::Vector3d::UnitX())), {0.5, 2.0, -1.0}, 1.2);
+  correct(S);
+  // Tracking posed it 0.1 m on from the second keyframe, in the old frame; it brings a point.
+  Eigen::Isometry3d T_made_from = Eigen::Isometry3d::Identity();
+  T_made_from.translation() = Eigen::Vector3d(-0.1, 0, 0);
+  KeyFrameMessage m;
+  m.keyframe.id = 13;
+  m.keyframe.map = kMap;
+  m.keyframe.full = true;
+  m.keyframe.frame = featureFrame(kPoints + 1);
+  m.keyframe.T_cw = T_made_from * poseAt(0.4);
+  m.keyframe.made_from = kSecond;
+  m.keyframe.T_made_from = T_made_from;
+  m.keyframe.matches.emplace_back(kPoints, kNewPoint);
+  PointRecord p;
+  p.id = kNewPoint;
+  p.position = Eigen::Vector3d(0.3, 0.2, 4.5);
+  p.full = true;
+  p.first_keyframe = 13;
+  m.points.push_back(p);
+  const auto added = integrator_.addKeyframe(m, 0);
+  ASSERT_TRUE(added.keyframe);
+  const Eigen::Isometry3d want = moved(T_made_from * poseAt(0.4), S);
+  EXPECT_LT((added.keyframe->T_cw.translation() - want.translation()).norm(), 1e-9);
+  EXPECT_LT(Eigen::AngleAxisd(want.linear().transpose() * added.keyframe->T_cw.linear()).angle(), 1e-9);
+  EXPECT_LT((*pointHere(kNewPoint) - S * p.position).norm(), 1e-9);
+}
+
+TEST_F(EpochLabels, ANewPointWithNoKeyframeToCarryItWaitsForAFreshRecord) {
+  correct(core::Sim3(Eigen::Quaterniond::Identity(), {1.0, 0, 0}, 1.1));
+  integrator_.applyLocal(staleLocalMap({0.2, -0.1, 4.0}, false));
+  EXPECT_FALSE(pointHere(kNewPoint));
+}
+
+}  // namespace
+}  // namespace hiveslam::distribution
