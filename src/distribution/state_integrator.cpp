@@ -241,44 +241,53 @@ StateIntegrator::Added StateIntegrator::addKeyframe(const KeyFrameMessage& m, ui
   return out;
 }
 
-bool StateIntegrator::carryStalePoint(core::Map& map, const MapRecord& m, PointRecord& p) {
-  // The point was triangulated in the coordinate frame the sender had before it applied this
-  // node's latest global map, like the window keyframes' poses in the same record. Carried
-  // through a window keyframe this node holds: the one that made the point, else any other.
-  const KeyFrameRecord* via = nullptr;
-  core::KeyFrame* here = nullptr;
+std::vector<PointRecord> StateIntegrator::carryNewPoints(const core::Map& map, const MapRecord& m) {
+  // The points were triangulated in the frame the sender had before it applied this node's
+  // latest global map, like the window keyframes' poses in the same record. Each is carried
+  // through a window keyframe held here: the one that made it, else the first one.
+  std::unordered_map<Id, const Eigen::Vector3d*> recorded;
+  for (const auto& q : m.points) recorded.emplace(q.id, &q.position);
+  struct Carry {
+    Eigen::Isometry3d T_was, T_is;
+    double scale = 1.0;
+  };
+  std::unordered_map<Id, Carry> carries;  // by keyframe
+  const Carry* first = nullptr;
   for (const auto& k : m.keyframes) {
     auto it = map.keyframes.find(k.id);
     if (it == map.keyframes.end()) continue;
-    if (!via || k.id == p.first_keyframe) {
-      via = &k;
-      here = it->second.get();
+    const core::KeyFrame& here = *it->second;
+    Carry c{k.T_cw, here.pose()};
+    // The correction may have rescaled the map around the keyframe: how far the record's
+    // points it sees are from it here, against in the record (as core::applyCorrection
+    // measures a rigid correction's scale).
+    std::vector<double> ratios;
+    for (const auto& q : here.points) {
+      if (!q || q->bad) continue;
+      auto r = recorded.find(q->id);
+      if (r == recorded.end()) continue;
+      const double was = (c.T_was * *r->second).norm(), is = (c.T_is * q->position).norm();
+      if (was > 1e-9 && is > 1e-9) ratios.push_back(is / was);
     }
-    if (k.id == p.first_keyframe) break;
+    if (ratios.size() >= 8) {
+      auto mid = ratios.begin() + static_cast<std::ptrdiff_t>(ratios.size() / 2);
+      std::nth_element(ratios.begin(), mid, ratios.end());
+      c.scale = *mid;
+    }
+    const Carry& stored = carries.emplace(k.id, c).first->second;
+    if (!first) first = &stored;
   }
-  if (!here) return false;
-  // The correction may have rescaled the map around that keyframe: how far the record's other
-  // points are from it here, against in the record (as core::applyCorrection measures it).
-  std::unordered_map<Id, const Eigen::Vector3d*> recorded;
-  for (const auto& q : m.points) recorded.emplace(q.id, &q.position);
-  const Eigen::Isometry3d T_here = here->pose();
-  std::vector<double> ratios;
-  for (const auto& q : here->points) {
-    if (!q || q->bad) continue;
-    auto it = recorded.find(q->id);
-    if (it == recorded.end()) continue;
-    const double was = (via->T_cw * *it->second).norm(), is = (T_here * q->position).norm();
-    if (was > 1e-9 && is > 1e-9) ratios.push_back(is / was);
+  std::vector<PointRecord> out;
+  if (!first) return out;
+  for (const auto& p : m.points) {
+    if (map.points.count(p.id)) continue;
+    auto by = carries.find(p.first_keyframe);
+    const Carry& c = by != carries.end() ? by->second : *first;
+    out.push_back(p);
+    out.back().position = c.T_is.inverse() * (c.scale * (c.T_was * p.position));
   }
-  double s = 1.0;
-  if (ratios.size() >= 8) {
-    auto mid = ratios.begin() + static_cast<std::ptrdiff_t>(ratios.size() / 2);
-    std::nth_element(ratios.begin(), mid, ratios.end());
-    s = *mid;
-  }
-  p.position = T_here.inverse() * (s * (via->T_cw * p.position));
-  ++stale_points_carried_;
-  return true;
+  stale_points_carried_ += out.size();
+  return out;
 }
 
 void StateIntegrator::applyLocal(const MapRecord& m) {
@@ -286,13 +295,11 @@ void StateIntegrator::applyLocal(const MapRecord& m) {
   if (!map || map->merged_into.load()) return;
   std::lock_guard lock(map->mutex);
   if (stale(*map, m.epoch)) {
-    for (const auto& p : m.points)
-      if (!map->points.count(p.id)) {
-        PointRecord carried = p;
-        if (!carryStalePoint(*map, m, carried)) continue;  // its next fresh record brings it
-        applyPoint(*map, carried);
-        observer_.record(carried);
-      }
+    // Points no keyframe here can carry come with the sender's next fresh record.
+    for (const auto& p : carryNewPoints(*map, m)) {
+      applyPoint(*map, p);
+      observer_.record(p);
+    }
     applyErasures(*map, m);
     for (Id id : m.erased_keyframes) observer_.eraseKeyframe(id);
     for (Id id : m.erased_points) observer_.erasePoint(id);

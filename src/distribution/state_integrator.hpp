@@ -58,9 +58,9 @@ class StateIntegrator {
   // True when the keyframe's point links changed.
   bool relink(core::Map& map, core::KeyFrame& kf, const KeyFrameRecord& r);
   void applyErasures(core::Map& map, const MapRecord& m);
-  // A new point of a stale local map, moved into this node's coordinate frame; false when no
-  // keyframe of the record is here to carry it.
-  bool carryStalePoint(core::Map& map, const MapRecord& m, PointRecord& p);
+  // A stale local map's new points, moved into the map's current frame; those no keyframe of
+  // the record held here can carry are left out.
+  std::vector<PointRecord> carryNewPoints(const core::Map& map, const MapRecord& m);
   std::shared_ptr<core::KeyFrame> makeKeyframe(const KeyFrameRecord& r) const;
   // With the map's mutex held: content labelled `label` is in an older frame than the map's.
   bool stale(const core::Map& map, uint64_t label) const;
