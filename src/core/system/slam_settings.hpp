@@ -29,9 +29,14 @@ struct SlamSettings {
   // keyframes (the paper's wait for the initial keyframes to be optimized).
   int lost_frames_before_new_map = 20;
   // Local mapping
-  int triangulation_neighbours = 10;
+  // Neighbours searched for new points and for duplicates: 20, ORB-SLAM's monocular value (10
+  // is its stereo one). A monocular map carries its scale through its points, and pairs with
+  // older keyframes give them wider baselines. Sequential runs at six feature budgets (median /
+  // max ATE, mm): figure8 10.6 / 24.0 -> 9.4 / 13.3, sweep 10.0 / 15.6 -> 6.2 / 14.2, blackout
+  // 7.9 / 11.2 -> 7.5 / 12.9 (docs/BENCHMARKS.md, session 10).
+  int triangulation_neighbours = 20;
   double triangulation_max_cos_parallax = 0.9998;  // new points need a wider angle (1.15 deg)
-  int fusion_neighbours = 10;
+  int fusion_neighbours = 20;
   int local_ba_iterations = 10;
   // A keyframe goes when this share of its points is seen by 3 others at the same or a finer
   // scale (ORB-SLAM's 0.9). 0.95 keeps a third more keyframes and cut the standalone system's
