@@ -29,14 +29,13 @@ struct SlamSettings {
   // keyframes (the paper's wait for the initial keyframes to be optimized).
   int lost_frames_before_new_map = 20;
   // Local mapping
-  // Neighbours searched for new points and for duplicates: 20, ORB-SLAM's monocular value (10
-  // is its stereo one). A monocular map carries its scale through its points, and pairs with
-  // older keyframes give them wider baselines. Sequential runs at six feature budgets (median /
-  // max ATE, mm): figure8 10.6 / 24.0 -> 9.4 / 13.3, sweep 10.0 / 15.6 -> 6.2 / 14.2, blackout
-  // 7.9 / 11.2 -> 7.5 / 12.9 (docs/BENCHMARKS.md, session 10).
-  int triangulation_neighbours = 20;
+  // Neighbours searched for new points (and, below, for duplicates). ORB-SLAM's monocular value
+  // is 20; 20 here helped the sequential runs (median ATE at six feature budgets: figure8 10.6 ->
+  // 9.4 mm, sweep 10.0 -> 6.2) but not the real-time bench (3-node sweep median 6.1 -> 12.7 mm):
+  // docs/BENCHMARKS.md, session 10.
+  int triangulation_neighbours = 10;
   double triangulation_max_cos_parallax = 0.9998;  // new points need a wider angle (1.15 deg)
-  int fusion_neighbours = 20;
+  int fusion_neighbours = 10;
   int local_ba_iterations = 10;
   // A keyframe goes when this share of its points is seen by 3 others at the same or a finer
   // scale (ORB-SLAM's 0.9). 0.95 keeps a third more keyframes and cut the standalone system's
