@@ -1,8 +1,8 @@
 #pragma once
 // ORB features (Rublee et al. 2011, with the spatially uniform selection of ORB-SLAM): a scale
-// pyramid, FAST corners per grid cell with an adaptive threshold, a quadtree that keeps the
-// strongest corner of each region, intensity-centroid orientation and 256-bit rotated BRIEF
-// descriptors over a smoothed image.
+// pyramid, FAST corners over each level with a lower threshold retried in the grid cells that
+// found none, a quadtree that keeps the strongest corner of each region, intensity-centroid
+// orientation and 256-bit rotated BRIEF descriptors over a smoothed image.
 #include <opencv2/core.hpp>
 #include <vector>
 
