@@ -297,18 +297,15 @@ void OrbExtractor::extract(const cv::Mat& gray, std::vector<cv::KeyPoint>& keypo
       found.push_back(kp);
     };
     std::vector<cv::KeyPoint>& k = scratch.fast;
-    {
-      // 3 px margin for the FAST circle, taken from the reflected border.
-      const cv::Rect all(kBorder - 3, kBorder - 3, W + 6, H + 6);
-      cv::FAST(padded(all), k, options_.fast_threshold, true);
-      for (const auto& kp : k) keep(kp, -3.0f, -3.0f);
-    }
+    // The whole level with a 3 px margin for the FAST circle, taken from the reflected border.
+    const cv::Rect all(kBorder - 3, kBorder - 3, W + 6, H + 6);
+    cv::FAST(padded(all), k, options_.fast_threshold, true);
+    for (const auto& kp : k) keep(kp, -3.0f, -3.0f);
     scratch.first_pass = per_cell;
     const auto empty_cells = std::count(per_cell.begin(), per_cell.end(), 0);
     if (2 * empty_cells > static_cast<long>(per_cell.size())) {
       // Mostly bare (a dark or blank view): one pass at the lower threshold over the whole level,
       // keeping the corners of the empty cells, costs a fraction of a FAST call per cell.
-      const cv::Rect all(kBorder - 3, kBorder - 3, W + 6, H + 6);
       cv::FAST(padded(all), k, options_.min_fast_threshold, true);
       for (const auto& kp : k) {
         const int x = static_cast<int>(kp.pt.x - 3), y = static_cast<int>(kp.pt.y - 3);
