@@ -61,7 +61,7 @@ DistributedNode::DistributedNode(core::SlamSystem& slam, communication::Transpor
   hooks.local_applied = [this](const MapRecord& m) {
     {
       std::lock_guard lock(mutex_);
-      for (const auto& k : m.keyframes) outstanding_.erase(k.id);
+      for (core::Id k : m.mapped) outstanding_.erase(k);
     }
     changed_.notify_all();
   };
@@ -172,7 +172,7 @@ void DistributedNode::keyframeCreated(const std::shared_ptr<core::Map>& map, con
   if (!plan().keyframes_to_lm) return;
   {
     std::lock_guard lock(mutex_);
-    outstanding_.insert(kf->id);
+    outstanding_.emplace(kf->id, std::chrono::steady_clock::now());
   }
   publisher_->push({map, kf, Topic::TrKeyframes, kTargetLm});
 }
@@ -187,7 +187,7 @@ void DistributedNode::keyframeTriangulated(const std::shared_ptr<core::Map>& map
     std::lock_guard lock(mutex_);
     if (peers_.empty()) return;
   }
-  handler_->markDirty(map, *kf, Topic::LmMap, 0);
+  handler_->markDirty(map, *kf, Topic::LmMap, 0, /*acknowledge=*/true);
 }
 
 void DistributedNode::keyframeMapped(const std::shared_ptr<core::Map>& map, const std::shared_ptr<core::KeyFrame>& kf) {
@@ -382,6 +382,10 @@ void DistributedNode::stop() {
 
 bool DistributedNode::remoteIdle() const {
   std::lock_guard lock(mutex_);
+  // An acknowledgement that never came (the keyframe was dropped at the gateway: its map was
+  // merged meanwhile, or the gateway changed) must not hold keyframes back for good.
+  const auto lost = std::chrono::steady_clock::now() - std::chrono::milliseconds(options_.settings.remote_mapping_wait_ms);
+  std::erase_if(outstanding_, [&](const auto& o) { return o.second < lost; });
   return outstanding_.empty();
 }
 

@@ -8,6 +8,7 @@
 // snapshot of its maps and Done on its map topic. A node is finished when it has that Done:
 // from then on every node's S_full holds the same keyframes and points (eventual consistency).
 #include <atomic>
+#include <chrono>
 #include <condition_variable>
 #include <map>
 #include <set>
@@ -88,7 +89,8 @@ class DistributedNode final : public core::SystemEvents {
   std::vector<communication::Topic> subscribed_;
   std::map<core::Id, uint64_t> synced_;     // last global epoch applied, per map
   std::map<core::Id, uint64_t> published_;  // LC: last global epoch published, per map
-  std::set<core::Id> outstanding_;          // TR: keyframes sent, not yet in a local map
+  // TR: keyframes sent, not yet acknowledged as mapped (MapRecord::mapped), with when they went.
+  mutable std::map<core::Id, std::chrono::steady_clock::time_point> outstanding_;
   std::vector<MapRecord> held_;             // local maps ahead of synced_, in arrival order
   bool done_ = false, lc_done_ = false;
   bool stopping_ = false;  // stop() has begun: no finisher may start any more

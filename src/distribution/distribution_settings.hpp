@@ -16,7 +16,9 @@ struct DistributionSettings {
   // Global maps (loop closure, merge, global BA): the whole map in batches.
   int global_batch = 10;
   int global_batch_gap_ms = 100;
-  // Offline runs: how long tracking waits for a remote local map before going on.
+  // How long tracking waits for the gateway to acknowledge its last keyframe as mapped: an
+  // offline run waits this long at most before going on; in any run, an acknowledgement this
+  // late counts as lost (the keyframe was dropped there) and no longer holds keyframes back.
   int remote_mapping_wait_ms = 2000;
 };
 

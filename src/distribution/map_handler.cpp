@@ -98,18 +98,23 @@ void MapHandler::incoming(communication::Message&& m, Topic topic) {
   wake_.notify_all();
 }
 
-void MapHandler::markDirty(const std::shared_ptr<core::Map>& map, const core::KeyFrame& kf, Topic topic, int window) {
-  std::vector<core::Id> kfs, points;
+void MapHandler::markDirty(const std::shared_ptr<core::Map>& map, const core::KeyFrame& kf, Topic topic, int window,
+                           bool acknowledge) {
+  // A keyframe culled meanwhile still goes into the dirty set when acknowledged (the batch
+  // skips it, the acknowledgement goes out): its maker waits for the word.
+  std::vector<core::Id> kfs{kf.id}, points;
   {
     std::lock_guard lock(map->mutex);
-    if (kf.bad) return;
-    std::vector<const core::KeyFrame*> changed{&kf};
-    for (const core::KeyFrame* n : kf.bestCovisible(static_cast<size_t>(window < 0 ? settings_.local_window : window)))
-      changed.push_back(n);
-    for (const core::KeyFrame* k : changed) {
-      kfs.push_back(k->id);
-      for (const auto& p : k->points)
-        if (p && !p->bad) points.push_back(p->id);
+    if (kf.bad && !acknowledge) return;
+    if (!kf.bad) {
+      std::vector<const core::KeyFrame*> changed{&kf};
+      for (const core::KeyFrame* n : kf.bestCovisible(static_cast<size_t>(window < 0 ? settings_.local_window : window))) {
+        changed.push_back(n);
+        kfs.push_back(n->id);
+      }
+      for (const core::KeyFrame* k : changed)
+        for (const auto& p : k->points)
+          if (p && !p->bad) points.push_back(p->id);
     }
   }
   {
@@ -119,6 +124,7 @@ void MapHandler::markDirty(const std::shared_ptr<core::Map>& map, const core::Ke
     o.topic = topic;
     o.dirty.insert(kfs.begin(), kfs.end());
     o.dirty_points.insert(points.begin(), points.end());
+    if (acknowledge) o.mapped.insert(kf.id);
     o.batch = 0;
   }
   wake_.notify_all();
@@ -209,6 +215,8 @@ void MapHandler::loop() {
         batch.dirty.insert(*o.dirty.begin());
         o.dirty.erase(o.dirty.begin());
       }
+      for (core::Id id : batch.dirty)
+        if (o.mapped.erase(id)) batch.mapped.insert(id);
       const bool last = o.dirty.empty();
       ++o.batch;
       // Points go with the first batch whose keyframes see them; the rest with the last batch.
@@ -268,6 +276,7 @@ void MapHandler::sendLocalBatch(Outgoing& o) {
       return;
     }
     m.origin = map.origin ? map.origin->id : kNoId;
+    m.mapped.assign(o.mapped.begin(), o.mapped.end());
     std::set<core::Id> unsent = o.dirty_points;
     for (core::Id id : o.dirty) {
       auto it = map.keyframes.find(id);
@@ -281,7 +290,7 @@ void MapHandler::sendLocalBatch(Outgoing& o) {
     takeJournal(map, m);
   }
   if (m.keyframes.empty() && m.points.empty() && m.erased_keyframes.empty() && m.erased_points.empty() &&
-      m.replaced_points.empty())
+      m.replaced_points.empty() && m.mapped.empty())
     return;
   trimForSending(m, o.topic, false);
   observer_.record(m);

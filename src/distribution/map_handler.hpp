@@ -42,9 +42,10 @@ class MapHandler {
 
   void incoming(communication::Message&& m, communication::Topic topic);
   // Local mapping changed `kf` and up to `window` of its covisible keyframes (the setting's
-  // local_window when negative), sent on `topic` with the points they see.
+  // local_window when negative), sent on `topic` with the points they see. `acknowledge`: the
+  // batch that carries `kf` also tells its maker that `kf` is mapped (MapRecord::mapped).
   void markDirty(const std::shared_ptr<core::Map>& map, const core::KeyFrame& kf, communication::Topic topic,
-                 int window = -1);
+                 int window = -1, bool acknowledge = false);
   // The whole map, as a global map of `epoch`, on `topic`.
   // `full`: every point with its full record and every keyframe with its links (a snapshot for
   // a node that may have missed updates: a newcomer, or the end of a run).
@@ -65,6 +66,7 @@ class MapHandler {
     communication::Topic topic{};
     std::set<core::Id, std::greater<>> dirty;  // keyframe ids, newest first
     std::set<core::Id> dirty_points;
+    std::set<core::Id> mapped;  // acknowledgements, each sent with the batch holding its keyframe
     int batch = 0;  // grows while no new keyframe is marked
   };
   struct GlobalJob {

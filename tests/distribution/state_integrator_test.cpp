@@ -7,6 +7,9 @@
 #include "core/camera/pinhole_radtan.hpp"
 #include "core/mapping/keyframe_insertion.hpp"
 #include "core/system/slam_system.hpp"
+#include "communication/inproc/inproc_network.hpp"
+#include "distribution/map_handler.hpp"
+#include "distribution/packet.hpp"
 #include "distribution/state_integrator.hpp"
 
 namespace hiveslam::distribution {
@@ -201,6 +204,62 @@ TEST_F(EpochLabels, ANewPointWithNoKeyframeToCarryItWaitsForAFreshRecord) {
   correct(core::Sim3(Eigen::Quaterniond::Identity(), {1.0, 0, 0}, 1.1));
   integrator_.applyLocal(staleLocalMap({0.2, -0.1, 4.0}, false));
   EXPECT_FALSE(pointHere(kNewPoint));
+}
+
+// Tracking makes its next keyframe once the gateway acknowledges its last as mapped. A local
+// map carries a keyframe's covisible neighbours too, the newest of which may not be mapped
+// yet: only the keyframe marked with `acknowledge` may count, or tracking runs ahead of
+// mapping and poses keyframes in a map without their predecessors' new points.
+TEST_F(EpochLabels, ALocalMapAcknowledgesOnlyTheKeyframeMappedNotItsNeighbours) {
+  communication::InProcNetwork network;
+  auto sender = network.endpoint(), receiver = network.endpoint();
+  std::mutex mutex;
+  std::vector<MapRecord> received;
+  receiver->start({}, [](const communication::PeerInfo&, bool) {});
+  receiver->subscribe(communication::Topic::LmMap, [&](communication::Message&& m) {
+    std::lock_guard lock(mutex);
+    received.push_back(decodeMap(unpack(m, PacketKind::Map)));
+  });
+  sender->start({}, [](const communication::PeerInfo&, bool) {});
+  SentLedger ledger;
+  MapHandler handler(*sender, integrator_, observer_, ledger, DistributionSettings{}, 2, {});
+  const auto map = slam_.findMap(kMap);
+  std::shared_ptr<core::KeyFrame> first, second;
+  {
+    std::lock_guard lock(map->mutex);
+    first = map->keyframes.at(kFirst);
+    second = map->keyframes.at(kSecond);
+  }
+  handler.markDirty(map, *first, communication::Topic::LmMap, -1, true);
+  handler.finish();
+  std::set<Id> carried, mapped;
+  {
+    std::lock_guard lock(mutex);
+    for (const auto& r : received) {
+      for (const auto& k : r.keyframes) carried.insert(k.id);
+      mapped.insert(r.mapped.begin(), r.mapped.end());
+    }
+  }
+  EXPECT_EQ(carried, (std::set<Id>{kFirst, kSecond}));  // the neighbour rides along
+  EXPECT_EQ(mapped, std::set<Id>{kFirst});
+
+  // A keyframe local mapping culled before its batch left is still acknowledged.
+  MapHandler again(*sender, integrator_, observer_, ledger, DistributionSettings{}, 2, {});
+  {
+    std::lock_guard lock(map->mutex);
+    second->bad = true;
+  }
+  {
+    std::lock_guard lock(mutex);
+    received.clear();
+  }
+  again.markDirty(map, *second, communication::Topic::LmMap, 0, true);
+  again.finish();
+  std::lock_guard lock(mutex);
+  ASSERT_FALSE(received.empty());
+  EXPECT_EQ(received.back().mapped, std::vector<Id>{kSecond});
+  sender->stop();
+  receiver->stop();
 }
 
 }  // namespace

@@ -65,12 +65,14 @@ TEST(Wire, MapRoundTripWithoutUnchangedLinks) {
   m.keyframes.push_back(k);
   m.erased_points = {9, 10};
   m.replaced_points = {{11, 12}};
+  m.mapped = {5};
   const auto back = decodeMap(unpack(pack(m, 1, 0, 7, 3), PacketKind::Map));
   EXPECT_EQ(back.kind, MapRecord::Kind::Global);
   EXPECT_EQ(back.batch, 1u);
   EXPECT_FALSE(back.keyframes.at(0).links);
   EXPECT_EQ(back.erased_points, m.erased_points);
   EXPECT_EQ(back.replaced_points, m.replaced_points);
+  EXPECT_EQ(back.mapped, m.mapped);
 }
 
 TEST(Wire, MalformedBodiesAreRejected) {

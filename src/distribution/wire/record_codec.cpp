@@ -224,6 +224,7 @@ std::vector<uint8_t> encode(const MapRecord& m) {
     w.put(b);
   }
   putIds(w, m.merged_maps);
+  putIds(w, m.mapped);
   return std::move(w.data());
 }
 
@@ -252,6 +253,7 @@ MapRecord decodeMap(const std::vector<uint8_t>& raw) {
     b = r.get<Id>();
   }
   m.merged_maps = getIds(r);
+  m.mapped = getIds(r);
   if (!r.done()) throw WireError("trailing bytes");
   return m;
 }

@@ -59,6 +59,10 @@ struct MapRecord {
   std::vector<Id> erased_keyframes, erased_points;
   std::vector<std::pair<Id, Id>> replaced_points;  // (old, by)
   std::vector<Id> merged_maps;                     // maps now living in `map`
+  // Keyframes whose local mapping got as far as their new points (which this record carries):
+  // the gateway's acknowledgement to the tracking node that made them. A keyframe merely
+  // listed above is no acknowledgement: it can ride along as a neighbour before it is mapped.
+  std::vector<Id> mapped;
 };
 
 // A new keyframe with the points it sees that the receiver may not know yet.
