@@ -2,12 +2,13 @@
 // map comes in the old coordinate frame (its label says which). Its new points must land where
 // the correction would have put them: a point left at its old position sits centimetres off in
 // a map a loop closure just moved, and the next loop search matches it with a wrong scale.
+// On the same two-keyframe map: which keyframes a local map acknowledges as mapped.
 #include <gtest/gtest.h>
 
+#include "communication/inproc/inproc_network.hpp"
 #include "core/camera/pinhole_radtan.hpp"
 #include "core/mapping/keyframe_insertion.hpp"
 #include "core/system/slam_system.hpp"
-#include "communication/inproc/inproc_network.hpp"
 #include "distribution/map_handler.hpp"
 #include "distribution/packet.hpp"
 #include "distribution/state_integrator.hpp"
