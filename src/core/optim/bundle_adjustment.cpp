@@ -7,6 +7,8 @@ namespace hiveslam::core {
 
 namespace {
 
+constexpr double kMinCosOffAxis = 0.1;  // cos 84.3 deg
+
 class AbortCallback : public ceres::IterationCallback {
  public:
   explicit AbortCallback(const std::atomic<bool>* flag) : flag_(flag) {}
@@ -25,10 +27,19 @@ BaSummary bundleAdjust(BaProblem& pb, const BaOptions& o) {
   problem_options.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
   ceres::Problem problem(problem_options);
   ceres::EigenQuaternionManifold quaternion;  // outlives the problem, which does not own it
-  std::vector<ceres::ResidualBlockId> blocks;
+  std::vector<ceres::ResidualBlockId> blocks;  // null: left out
   for (const auto& ob : pb.observations) {
     auto& pose = pb.poses[static_cast<size_t>(ob.pose)];
     auto& point = pb.points[static_cast<size_t>(ob.point)];
+    // A point beside or behind the camera (over 84 degrees off its axis) cannot be what the
+    // keypoint saw, and near the camera plane the projection's derivatives blow up: one such
+    // observation (a point 0.009 behind a new keyframe) outweighed 4,900 others, dragged the
+    // keyframe 0.29 map units off and left it with one point. It goes out as an outlier.
+    const Eigen::Vector3d pc = pose.q_cw * point.p_w + pose.t_cw;
+    if (pc.z() <= kMinCosOffAxis * pc.norm()) {
+      blocks.push_back(nullptr);
+      continue;
+    }
     auto* cost = new ceres::AutoDiffCostFunction<ReprojectionError, 2, 4, 3, 3>(
         new ReprojectionError(pb.K, ob.uv, ob.inv_sigma));
     blocks.push_back(problem.AddResidualBlock(cost, new ceres::HuberLoss(o.huber_px), pose.q_cw.coeffs().data(),
@@ -55,7 +66,7 @@ BaSummary bundleAdjust(BaProblem& pb, const BaOptions& o) {
   AbortCallback abort(o.abort);
   options.callbacks.push_back(&abort);
   ceres::Solver::Summary summary;
-  ceres::Solve(options, &problem, &summary);
+  if (problem.NumResidualBlocks() > 0) ceres::Solve(options, &problem, &summary);
 
   BaSummary out;
   out.initial_cost = summary.initial_cost;
@@ -66,7 +77,7 @@ BaSummary bundleAdjust(BaProblem& pb, const BaOptions& o) {
       const auto& ob = pb.observations[i];
       const auto& pose = pb.poses[static_cast<size_t>(ob.pose)];
       const Eigen::Vector3d pc = pose.q_cw * pb.points[static_cast<size_t>(ob.point)].p_w + pose.t_cw;
-      const double chi2 = pc.z() <= 0 ? 1e9 : ((pb.K.project(pc) - ob.uv) * ob.inv_sigma).squaredNorm();
+      const double chi2 = pc.z() <= kMinCosOffAxis * pc.norm() ? 1e9 : ((pb.K.project(pc) - ob.uv) * ob.inv_sigma).squaredNorm();
       out.outlier[i] = chi2 > 5.991;
     }
   };
@@ -76,7 +87,7 @@ BaSummary bundleAdjust(BaProblem& pb, const BaOptions& o) {
   out.aborted = aborted;
   int removed = 0;
   for (size_t i = 0; i < blocks.size() && !aborted && o.outlier_round; ++i)
-    if (out.outlier[i] && problem.NumResidualBlocks() > 1) {
+    if (out.outlier[i] && blocks[i] && problem.NumResidualBlocks() > 1) {
       problem.RemoveResidualBlock(blocks[i]);
       ++removed;
     }
