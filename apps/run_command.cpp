@@ -33,8 +33,10 @@ nlohmann::json loopEventsJson(const core::LoopStats& stats) {
   for (const auto& e : stats.events)
     events.push_back({{"kind", e.kind == core::LoopEvent::Kind::Loop ? "loop" : "merge"},
                       {"timestamp", e.timestamp},
+                      {"place_timestamp", e.place_timestamp},
                       {"matches", e.matches},
                       {"scale", e.scale},
+                      {"scale_agreement", e.scale_agreement},
                       {"correct_ms", e.correct_ms},
                       {"essential_graph_ms", e.essential_graph_ms}});
   return events;

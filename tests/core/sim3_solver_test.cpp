@@ -81,6 +81,30 @@ TEST(Sim3Solver, ThePointsTellTheScaleWhereTheReprojectionsCannot) {
   EXPECT_NEAR(pointScale(matches, S, inlier), truth.s, 0.005);
 }
 
+// The points of a consistent pair of maps agree on one scale; where half of one side sits at a
+// third of its depth, the median is no scale the two share, and the agreement says so.
+TEST(Sim3Solver, ThePointsAgreeOnTheScaleOnlyWhereBothMapsAreConsistent) {
+  std::mt19937 rng(4);
+  std::uniform_real_distribution<double> u(-1, 1);
+  const Sim3 truth(Eigen::Quaterniond(Eigen::AngleAxisd(0.1, Eigen::Vector3d::UnitY())), Eigen::Vector3d(0.2, 0, 0), 1.05);
+  std::vector<Sim3Match> matches;
+  for (int i = 0; i < 100; ++i) {
+    Sim3Match m;
+    m.p2 = Eigen::Vector3d(1.5 * u(rng), u(rng), 3 + u(rng));
+    m.p1 = (truth * m.p2) * (1 + 0.03 * u(rng));
+    m.uv1 = m.uv2 = Eigen::Vector2d::Zero();  // only the points are asked
+    matches.push_back(m);
+  }
+  std::vector<bool> inlier(matches.size(), true);
+  Sim3 S = truth;
+  S.s = pointScale(matches, S, inlier);
+  EXPECT_NEAR(S.s, truth.s, 0.02);
+  EXPECT_DOUBLE_EQ(pointScaleAgreement(matches, S, inlier, 0.2), 1.0);
+  for (size_t i = 0; i < matches.size(); i += 2) matches[i].p1 = S.t + 0.35 * (matches[i].p1 - S.t);
+  S.s = pointScale(matches, S, inlier);
+  EXPECT_LT(pointScaleAgreement(matches, S, inlier, 0.2), 0.6);
+}
+
 TEST(Sim3Solver, RefusesMatchesWithoutACommonSimilarity) {
   std::mt19937 rng(5);
   std::uniform_real_distribution<double> u(-1, 1);

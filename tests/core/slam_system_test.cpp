@@ -17,8 +17,8 @@ namespace {
 struct SlamRun {
   io::Trajectory estimate, truth;
   int frames = 0, tracked = 0;
-  int loops = 0, merges = 0;
-  size_t live_maps = 0;
+  int loops = 0, merges = 0, global_bas = 0;
+  size_t live_maps = 0, keyframes = 0;
 };
 
 std::shared_ptr<const place::Vocabulary> shippedVocabulary() {
@@ -29,7 +29,7 @@ std::shared_ptr<const place::Vocabulary> shippedVocabulary() {
 
 // Frames [first, first + count) of a sequence of `total` frames (its speed set by `total`).
 SlamRun runSequence(const std::string& trajectory, int total, int first, int count, uint64_t seed, SlamSystem::Mode mode,
-                    std::shared_ptr<const place::Vocabulary> vocabulary = nullptr) {
+                    std::shared_ptr<const place::Vocabulary> vocabulary = nullptr, const SlamSettings& settings = {}) {
   synth::SequenceOptions o;
   o.trajectory = trajectory;
   o.frames = total;
@@ -38,7 +38,7 @@ SlamRun runSequence(const std::string& trajectory, int total, int first, int cou
   const synth::RayTable rays(model.lens);
   auto camera = std::make_shared<camera::PinholeRadTan>(model.lens.width, model.lens.height, model.lens.fx,
                                                         model.lens.fy, model.lens.cx, model.lens.cy);
-  SlamSystem slam(SlamSettings{}, camera, mode, std::move(vocabulary));
+  SlamSystem slam(settings, camera, mode, std::move(vocabulary));
   SlamRun run;
   // Rendering costs as much as tracking: tests that run one sequence twice render it once.
   static std::map<std::string, cv::Mat> rendered;
@@ -59,7 +59,12 @@ SlamRun runSequence(const std::string& trajectory, int total, int first, int cou
   }
   run.loops = slam.loopStats().loops;
   run.merges = slam.loopStats().merges;
+  run.global_bas = slam.loopStats().global_bas;
   run.live_maps = slam.liveMaps().size();
+  {
+    std::lock_guard lock(map->mutex);
+    run.keyframes = map->keyframes.size();
+  }
   return run;
 }
 
@@ -104,12 +109,18 @@ TEST(SlamSystem, MergesTheMapsAcrossABlankSegment) {
 }
 
 // Along one wall and back along the other: every place looks alike (the same texture statistics
-// everywhere) but none is visited twice, so nothing may be closed or merged.
+// everywhere) but none is visited twice, so nothing may be closed or merged. With
+// global_ba_every_keyframes set, the map still gets a global BA each time it has grown by that
+// many keyframes (culled ones counted out).
 TEST(SlamSystem, ClosesNoLoopOnASequenceThatNeverRevisits) {
-  const SlamRun run = runSequence("sweep", 400, 0, 400, 3, SlamSystem::Mode::Sequential, shippedVocabulary());
+  SlamSettings settings;
+  const int every = settings.global_ba_every_keyframes = 10;
+  const SlamRun run = runSequence("sweep", 400, 0, 400, 3, SlamSystem::Mode::Sequential, shippedVocabulary(), settings);
   EXPECT_GE(run.tracked, 0.9 * run.frames);
   EXPECT_EQ(run.loops, 0);
   EXPECT_EQ(run.merges, 0);
+  EXPECT_GE(run.global_bas, static_cast<int>(run.keyframes) / every - 1) << run.keyframes << " keyframes";
+  EXPECT_LE(run.global_bas, static_cast<int>(run.keyframes) / every + 1) << run.keyframes << " keyframes";
 }
 
 // The sweep sequence (600 frames, seed 4), its ray table and an ideal pinhole camera.

@@ -79,13 +79,31 @@ Sim3Result solveSim3Ransac(const Intrinsics& K1, const Intrinsics& K2, const std
   return best;
 }
 
-double pointScale(const std::vector<Sim3Match>& matches, const Sim3& S12, const std::vector<bool>& inlier) {
+namespace {
+
+std::vector<double> depthRatios(const std::vector<Sim3Match>& matches, const Sim3& S12, const std::vector<bool>& inlier) {
   std::vector<double> ratios;
   for (size_t k = 0; k < matches.size() && k < inlier.size(); ++k) {
     if (!inlier[k]) continue;
     const Eigen::Vector3d q = S12.q * matches[k].p2;
     if (q.squaredNorm() > 1e-12) ratios.push_back((matches[k].p1 - S12.t).dot(q) / q.squaredNorm());
   }
+  return ratios;
+}
+
+}  // namespace
+
+double pointScaleAgreement(const std::vector<Sim3Match>& matches, const Sim3& S12, const std::vector<bool>& inlier,
+                           double tolerance) {
+  const std::vector<double> ratios = depthRatios(matches, S12, inlier);
+  if (ratios.empty()) return 0;
+  const auto near = std::count_if(ratios.begin(), ratios.end(),
+                                  [&](double r) { return std::abs(r / S12.s - 1.0) <= tolerance; });
+  return static_cast<double>(near) / static_cast<double>(ratios.size());
+}
+
+double pointScale(const std::vector<Sim3Match>& matches, const Sim3& S12, const std::vector<bool>& inlier) {
+  std::vector<double> ratios = depthRatios(matches, S12, inlier);
   if (ratios.empty()) return S12.s;
   auto mid = ratios.begin() + static_cast<std::ptrdiff_t>(ratios.size() / 2);
   std::nth_element(ratios.begin(), mid, ratios.end());

@@ -43,4 +43,10 @@ bool sim3Inlier(const Intrinsics& K1, const Intrinsics& K2, const Sim3Match& m, 
 // again from where it was seen before): x -> s R x projects the same for every s.
 double pointScale(const std::vector<Sim3Match>& matches, const Sim3& S12, const std::vector<bool>& inlier);
 
+// The share of the inliers whose own ratio lies within `tolerance` (relative) of S12.s. A true
+// place on a consistent map gives one ratio up to the points' depth noise; a median that only a
+// few points agree with is not a scale the two maps share.
+double pointScaleAgreement(const std::vector<Sim3Match>& matches, const Sim3& S12, const std::vector<bool>& inlier,
+                           double tolerance);
+
 }  // namespace hiveslam::core

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 
 #include "core/geometry/sim3_solver.hpp"
 #include "core/loop/map_correction.hpp"
@@ -55,6 +56,7 @@ struct LoopCloser::Verified {
   Sim3 S12;        // place camera -> keyframe camera
   Sim3 S_cw;       // world (of the place's map) -> keyframe camera: the keyframe's corrected pose
   int matches = 0;
+  double scale_agreement = 0;  // share of the inliers whose depth ratio agrees with S12.s
   std::vector<KeyFrame*> place_group;
   std::vector<std::shared_ptr<MapPoint>> place_points;
 };
@@ -173,6 +175,7 @@ bool LoopCloser::verify(KeyFrame& kf, KeyFrame& place, Verified& out) const {
   out.place = &place;
   out.S12 = S;
   out.S_cw = S * Sim3(place.T_cw);
+  out.scale_agreement = pointScaleAgreement(matches, S, inlier, 0.2);
   placeGroup(place, out.place_group, out.place_points);
   std::vector<bool> seen(kf.points.size(), false);
   int total = 0;
@@ -305,11 +308,13 @@ void LoopCloser::process(const std::shared_ptr<Map>& map_handle, const std::shar
     LoopEvent event;
     event.kind = LoopEvent::Kind::Loop;
     event.timestamp = kf.frame.timestamp;
+    event.place_timestamp = place->frame.timestamp;
     event.keyframe = kf.id;
     event.matched = place->id;
     event.map = map.id;
     event.matches = v.matches;
     event.scale = v.S12.s;
+    event.scale_agreement = v.scale_agreement;
     event.correct_ms = msSince(t0);
     optimizeEssentialGraph(map, c, event);
     stats_.events.push_back(event);
@@ -319,6 +324,18 @@ void LoopCloser::process(const std::shared_ptr<Map>& map_handle, const std::shar
     keyframes_since_loop_ = 0;
     globalBundleAdjustment(map);
     return;
+  }
+  // No loop: the map still gets a global BA each time it has grown by global_ba_every_keyframes.
+  // Local BA holds its border fixed where earlier windows left it, so their errors (the young
+  // map's scale above all) are never revisited; a full BA lets every observation weigh in.
+  if (settings_.global_ba_every_keyframes > 0) {
+    size_t size = 0;
+    {
+      std::lock_guard lock(map.mutex);
+      size = map.keyframes.size();
+    }
+    if (size >= keyframes_at_global_ba_[map.id] + static_cast<size_t>(settings_.global_ba_every_keyframes))
+      globalBundleAdjustment(map);
   }
 }
 
@@ -433,6 +450,7 @@ void LoopCloser::globalBundleAdjustment(Map& map) {
     for (const auto& [id, k] : map.keyframes)
       if (!k->bad) kfs.push_back(k.get());
     std::sort(kfs.begin(), kfs.end(), [](KeyFrame* a, KeyFrame* b) { return a->id < b->id; });
+    keyframes_at_global_ba_[map.id] = map.keyframes.size();
     if (kfs.size() < 3) return;
     ba.K = kfs.front()->frame.K;
     for (KeyFrame* k : kfs) {
@@ -519,12 +537,14 @@ void LoopCloser::mergeMaps(Map& map, KeyFrame& kf, Map& other, const Verified& v
   LoopEvent event;
   event.kind = LoopEvent::Kind::Merge;
   event.timestamp = kf.frame.timestamp;
+  event.place_timestamp = v.place->frame.timestamp;
   event.keyframe = kf.id;
   event.matched = v.place->id;
   event.map = map.id;
   event.merged_map = other.id;
   event.matches = v.matches;
   event.scale = S_ab.s;
+  event.scale_agreement = v.scale_agreement;
   stats_.events.push_back(event);
   ++stats_.merges;
 }

@@ -27,10 +27,14 @@ namespace hiveslam::core {
 struct LoopEvent {
   enum class Kind { Loop, Merge } kind = Kind::Loop;
   double timestamp = 0;  // of the keyframe that recognized the place
+  double place_timestamp = 0;  // of the place it recognized
   Id keyframe = kNoId, matched = kNoId;
   Id map = kNoId, merged_map = kNoId;
   int matches = 0;
   double scale = 1.0;   // scale of the correcting Sim3 (drift seen at the loop)
+  // Share of the inliers' own depth ratios within 20% of `scale`: near 1 when both sides are
+  // one consistent map (figure8's 0.29 loop had 0.98: its map had truly shrunk in a turn).
+  double scale_agreement = 0;
   double correct_ms = 0, essential_graph_ms = 0;  // detection to corrected loop; pose graph
 };
 
@@ -90,6 +94,7 @@ class LoopCloser {
   // Groups (keyframe ids) that recent keyframes recognized, with how many in a row did.
   Groups loop_groups_, merge_groups_;
   int keyframes_since_loop_ = 1000;
+  std::unordered_map<Id, size_t> keyframes_at_global_ba_;  // by map: its size at its last global BA
   LoopStats stats_;
   const std::atomic<Map*>* active_ = nullptr;
   std::function<void(const GlobalUpdate&)> on_update_;
