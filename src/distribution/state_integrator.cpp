@@ -138,9 +138,9 @@ void StateIntegrator::noteEpoch(const core::Map& map, uint64_t label) {
   std::lock_guard lock(epochs_mutex_);
   auto& frames = epochs_[map.id];
   frames[label] = std::move(f);
-  // Content older than a few global updates is not expected: its sender would be that far
-  // behind, and the 3 kept are a second or more of updates.
-  while (frames.size() > 3) frames.erase(frames.begin());
+  // A sender can be several updates behind: a global map takes a second or more to send, and
+  // a loop brings two (the correction, then its global BA) on top of any periodic global BA.
+  while (frames.size() > kLabelsKept) frames.erase(frames.begin());
 }
 
 const StateIntegrator::Frame* StateIntegrator::frameOf(const core::Map& map, uint64_t label) const {
@@ -160,8 +160,12 @@ bool StateIntegrator::stale(const core::Map& map, uint64_t label) const {
   std::lock_guard lock(epochs_mutex_);
   if (const Frame* f = frameOf(map, label)) return f->core_epoch != map.epoch;
   // Before any global map, every node holds the map in the frame it was made in (core epoch
-  // 0 everywhere). Any other unknown label is ahead of this node (held back by the caller).
-  return label == 0 && map.epoch != 0;
+  // 0 everywhere). Labels only grow: one below those kept is older than all of them (taking
+  // it as current left bigloop's last keyframes without the last loop's correction, 48 mm
+  // off); any other unknown label is ahead of this node (held back by the caller).
+  if (label == 0) return map.epoch != 0;
+  auto it = epochs_.find(map.id);
+  return it != epochs_.end() && !it->second.empty() && label < it->second.begin()->first;
 }
 
 StateIntegrator::Added StateIntegrator::addKeyframe(const KeyFrameMessage& m, uint64_t label) {

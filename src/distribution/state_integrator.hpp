@@ -25,6 +25,10 @@ namespace hiveslam::distribution {
 
 class StateIntegrator {
  public:
+  // Content from a node up to this many global updates behind is carried with the map's scale
+  // change since; older content is carried without it (the scale taken as unchanged).
+  static constexpr size_t kLabelsKept = 16;
+
   StateIntegrator(core::SlamSystem& slam, Observer& observer) : slam_(slam), observer_(observer) {}
 
   // A new keyframe (with its new points and, for a new map, its first keyframe). Returns the
@@ -75,7 +79,7 @@ class StateIntegrator {
   };
   // With the map's mutex held: the frame `label` stood for here; null when unknown.
   const Frame* frameOf(const core::Map& map, uint64_t label) const;  // epochs_mutex_ held
-  // Per map, the last few labels. Taken after a map's mutex.
+  // Per map, the last kLabelsKept labels. Taken after a map's mutex.
   mutable std::mutex epochs_mutex_;
   std::unordered_map<Id, std::map<uint64_t, Frame>> epochs_;
 };

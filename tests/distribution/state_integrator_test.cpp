@@ -75,12 +75,13 @@ class EpochLabels : public ::testing::Test {
     }
   }
 
-  // The loop closure: the whole map moves by S (the global map of epoch 1).
-  void correct(const core::Sim3& S) {
+  // The loop closure: the whole map moves by S from where it was made (the global map of
+  // `epoch`).
+  void correct(const core::Sim3& S, uint64_t epoch = 1) {
     MapRecord g;
     g.kind = MapRecord::Kind::Global;
     g.map = kMap;
-    g.epoch = 1;
+    g.epoch = epoch;
     for (Id kf : {kFirst, kSecond}) {
       KeyFrameRecord k;
       k.id = kf;
@@ -199,6 +200,32 @@ TEST_F(EpochLabels, AKeyframeMadeBeforeTheCorrectionIsRePosedWithItsPointsScaleI
   EXPECT_LT((added.keyframe->T_cw.translation() - want.translation()).norm(), 1e-9);
   EXPECT_LT(Eigen::AngleAxisd(want.linear().transpose() * added.keyframe->T_cw.linear()).angle(), 1e-9);
   EXPECT_LT((*pointHere(kNewPoint) - S * p.position).norm(), 1e-9);
+}
+
+// A sender many global updates behind (each global map takes a second or more to send, and
+// global BAs follow one another): its label is older than every one this node keeps. It is
+// still from an old frame, and its keyframe is re-posed, not taken as it is.
+TEST_F(EpochLabels, AKeyframeFromFarBehindIsStillRePosed) {
+  const core::Sim3 S1(Eigen::Quaterniond::Identity(), {0.5, 0, 0}, 1.0);
+  const core::Sim3 S2(Eigen::Quaterniond(Eigen::AngleAxisd(0.2, Eigen::Vector3d::UnitX())), {0.5, 2.0, -1.0}, 1.0);
+  correct(S1, 1);
+  correct(S2, 2);
+  for (uint64_t e = 3; e < 3 + StateIntegrator::kLabelsKept; ++e) correct(S2, e);  // no further move
+  Eigen::Isometry3d T_made_from = Eigen::Isometry3d::Identity();
+  T_made_from.translation() = Eigen::Vector3d(-0.1, 0, 0);
+  KeyFrameMessage m;
+  m.keyframe.id = 13;
+  m.keyframe.map = kMap;
+  m.keyframe.full = true;
+  m.keyframe.frame = featureFrame(kPoints + 1);
+  m.keyframe.T_cw = T_made_from * moved(poseAt(0.4), S1);  // posed in the frame of label 1
+  m.keyframe.made_from = kSecond;
+  m.keyframe.T_made_from = T_made_from;
+  const auto added = integrator_.addKeyframe(m, 1);
+  ASSERT_TRUE(added.keyframe);
+  const Eigen::Isometry3d want = T_made_from * moved(poseAt(0.4), S2);
+  EXPECT_LT((added.keyframe->T_cw.translation() - want.translation()).norm(), 1e-9);
+  EXPECT_LT(Eigen::AngleAxisd(want.linear().transpose() * added.keyframe->T_cw.linear()).angle(), 1e-9);
 }
 
 TEST_F(EpochLabels, ANewPointWithNoKeyframeToCarryItWaitsForAFreshRecord) {
