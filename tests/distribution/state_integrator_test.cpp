@@ -128,6 +128,25 @@ class EpochLabels : public ::testing::Test {
     return m;
   }
 
+  // Keyframe 13, which tracking posed 0.1 m on from the second keyframe, whose pose there
+  // was T_second: the frame the message is in.
+  static KeyFrameMessage keyframeOnSecond(const Eigen::Isometry3d& T_second) {
+    KeyFrameMessage m;
+    m.keyframe.id = 13;
+    m.keyframe.map = kMap;
+    m.keyframe.full = true;
+    m.keyframe.frame = featureFrame(kPoints + 1);
+    m.keyframe.T_made_from.translation() = Eigen::Vector3d(-0.1, 0, 0);
+    m.keyframe.T_cw = m.keyframe.T_made_from * T_second;
+    m.keyframe.made_from = kSecond;
+    return m;
+  }
+
+  static void expectPose(const core::KeyFrame& kf, const Eigen::Isometry3d& want) {
+    EXPECT_LT((kf.T_cw.translation() - want.translation()).norm(), 1e-9);
+    EXPECT_LT(Eigen::AngleAxisd(want.linear().transpose() * kf.T_cw.linear()).angle(), 1e-9);
+  }
+
   std::optional<Eigen::Vector3d> pointHere(Id id) {
     auto map = slam_.findMap(kMap);
     std::lock_guard lock(map->mutex);
@@ -176,17 +195,8 @@ TEST_F(EpochLabels, AFreshLocalMapIsTakenAsItIs) {
 TEST_F(EpochLabels, AKeyframeMadeBeforeTheCorrectionIsRePosedWithItsPointsScaleIncluded) {
   const core::Sim3 S(Eigen::Quaterniond(Eigen::AngleAxisd(0.2, Eigen::Vector3d::UnitX())), {0.5, 2.0, -1.0}, 1.2);
   correct(S);
-  // Tracking posed it 0.1 m on from the second keyframe, in the old frame; it brings a point.
-  Eigen::Isometry3d T_made_from = Eigen::Isometry3d::Identity();
-  T_made_from.translation() = Eigen::Vector3d(-0.1, 0, 0);
-  KeyFrameMessage m;
-  m.keyframe.id = 13;
-  m.keyframe.map = kMap;
-  m.keyframe.full = true;
-  m.keyframe.frame = featureFrame(kPoints + 1);
-  m.keyframe.T_cw = T_made_from * poseAt(0.4);
-  m.keyframe.made_from = kSecond;
-  m.keyframe.T_made_from = T_made_from;
+  // Tracking posed it in the old frame; it brings a point.
+  KeyFrameMessage m = keyframeOnSecond(poseAt(0.4));
   m.keyframe.matches.emplace_back(kPoints, kNewPoint);
   PointRecord p;
   p.id = kNewPoint;
@@ -196,9 +206,7 @@ TEST_F(EpochLabels, AKeyframeMadeBeforeTheCorrectionIsRePosedWithItsPointsScaleI
   m.points.push_back(p);
   const auto added = integrator_.addKeyframe(m, 0);
   ASSERT_TRUE(added.keyframe);
-  const Eigen::Isometry3d want = moved(T_made_from * poseAt(0.4), S);
-  EXPECT_LT((added.keyframe->T_cw.translation() - want.translation()).norm(), 1e-9);
-  EXPECT_LT(Eigen::AngleAxisd(want.linear().transpose() * added.keyframe->T_cw.linear()).angle(), 1e-9);
+  expectPose(*added.keyframe, moved(m.keyframe.T_cw, S));
   EXPECT_LT((*pointHere(kNewPoint) - S * p.position).norm(), 1e-9);
 }
 
@@ -211,21 +219,10 @@ TEST_F(EpochLabels, AKeyframeFromFarBehindIsStillRePosed) {
   correct(S1, 1);
   correct(S2, 2);
   for (uint64_t e = 3; e < 3 + StateIntegrator::kLabelsKept; ++e) correct(S2, e);  // no further move
-  Eigen::Isometry3d T_made_from = Eigen::Isometry3d::Identity();
-  T_made_from.translation() = Eigen::Vector3d(-0.1, 0, 0);
-  KeyFrameMessage m;
-  m.keyframe.id = 13;
-  m.keyframe.map = kMap;
-  m.keyframe.full = true;
-  m.keyframe.frame = featureFrame(kPoints + 1);
-  m.keyframe.T_cw = T_made_from * moved(poseAt(0.4), S1);  // posed in the frame of label 1
-  m.keyframe.made_from = kSecond;
-  m.keyframe.T_made_from = T_made_from;
+  const KeyFrameMessage m = keyframeOnSecond(moved(poseAt(0.4), S1));  // in the frame of label 1
   const auto added = integrator_.addKeyframe(m, 1);
   ASSERT_TRUE(added.keyframe);
-  const Eigen::Isometry3d want = T_made_from * moved(poseAt(0.4), S2);
-  EXPECT_LT((added.keyframe->T_cw.translation() - want.translation()).norm(), 1e-9);
-  EXPECT_LT(Eigen::AngleAxisd(want.linear().transpose() * added.keyframe->T_cw.linear()).angle(), 1e-9);
+  expectPose(*added.keyframe, m.keyframe.T_made_from * moved(poseAt(0.4), S2));
 }
 
 TEST_F(EpochLabels, ANewPointWithNoKeyframeToCarryItWaitsForAFreshRecord) {
