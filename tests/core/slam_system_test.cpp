@@ -2,12 +2,15 @@
 // same input gives the same trajectory.
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <cstdio>
 #include <map>
 #include <mutex>
 #include <string>
 
 #include "core/camera/pinhole_radtan.hpp"
 #include "core/system/slam_system.hpp"
+#include "eval/similarity.hpp"
 #include "eval/trajectory_error.hpp"
 #include "synth/sequence.hpp"
 
@@ -216,6 +219,76 @@ TEST(SlamSystem, NewPointsAreReportedBeforeLocalBa) {
     if (r.keyframe && r.reference && recorder.at_triangulation.count(r.reference->id))
       grew += recorder.at_triangulation[r.reference->id] > static_cast<size_t>(r.inliers);
   EXPECT_GE(grew, recorder.at_triangulation.size() / 2);
+}
+
+
+// New points must lie on the scene. A false match along an epipolar band still triangulates
+// (two rays that meet the epipolar constraint meet somewhere), often centimetres from the
+// cameras, and one such point outweighs a hundred true ones in the next frames' poses. Each
+// keyframe's points are checked as local mapping makes them, against the true distance to the
+// scene along their rays; the keyframe's own median ratio stands in for the map's scale. A
+// point more than 25% off that counts as off the scene.
+struct NewPointCheck : SystemEvents {
+  NewPointCheck(const synth::SequenceModel& model, const std::map<double, int>& frame_at)
+      : model(model), frame_at(frame_at) {}
+  const synth::SequenceModel& model;
+  const std::map<double, int>& frame_at;
+  size_t created = 0, off = 0;
+
+  void keyframeTriangulated(const std::shared_ptr<Map>& map, const std::shared_ptr<KeyFrame>& kf) override {
+    std::lock_guard lock(map->mutex);
+    const Eigen::Isometry3d T_wc = model.pose(frame_at.at(kf->frame.timestamp));
+    std::vector<double> ratios;
+    std::vector<bool> is_new;
+    for (size_t i = 0; i < kf->points.size(); ++i) {
+      const auto& p = kf->points[i];
+      if (!p || p->bad) continue;
+      const Eigen::Vector3d dir = (T_wc.linear() * kf->frame.K.ray(kf->frame.points[i])).normalized();
+      const auto hit = model.scene.intersect(T_wc.translation(), dir);
+      if (!hit) continue;
+      ratios.push_back((p->position - kf->center()).norm() / hit->t);
+      is_new.push_back(p->first_keyframe == kf->id);
+    }
+    if (ratios.size() < 20) return;
+    std::vector<double> sorted = ratios;
+    std::nth_element(sorted.begin(), sorted.begin() + static_cast<long>(sorted.size() / 2), sorted.end());
+    const double scale = sorted[sorted.size() / 2];
+    for (size_t k = 0; k < ratios.size(); ++k) {
+      if (!is_new[k]) continue;
+      ++created;
+      off += std::abs(ratios[k] / scale - 1) > 0.25;
+    }
+  }
+};
+
+std::pair<size_t, size_t> newPointsOffTheScene(std::shared_ptr<const place::Vocabulary> vocabulary) {
+  // Frames 200-360 of the standard figure8: its fast turn past a box.
+  synth::SequenceOptions o;
+  o.trajectory = "figure8";
+  o.frames = 1000;
+  o.seed = 2;
+  const auto model = synth::buildSequence(o);
+  const synth::RayTable rays(model.lens);
+  auto camera = std::make_shared<camera::PinholeRadTan>(model.lens.width, model.lens.height, model.lens.fx,
+                                                        model.lens.fy, model.lens.cx, model.lens.cy);
+  std::map<double, int> frame_at;
+  for (int f = 200; f < 360; ++f) frame_at[model.stamp(f)] = f;
+  NewPointCheck check(model, frame_at);
+  SlamSystem slam(SlamSettings{}, camera, SlamSystem::Mode::Sequential, std::move(vocabulary));
+  slam.setEvents(&check);
+  for (int f = 200; f < 360; ++f) slam.process(model.renderImage(f, rays), model.stamp(f));
+  slam.finish();
+  return {check.created, check.off};
+}
+
+TEST(SlamSystem, NewPointsLieOnTheSceneThroughAFastTurn) {
+  // Measured: 4.4% off, in both the vocabulary-node and the whole-band search; about two thirds
+  // of those at under half their true distance (docs/BENCHMARKS.md, session 13).
+  const auto [created, off] = newPointsOffTheScene(shippedVocabulary());
+  RecordProperty("new_points", static_cast<int>(created));
+  RecordProperty("off_the_scene", static_cast<int>(off));
+  ASSERT_GT(created, 2000u);
+  EXPECT_LT(static_cast<double>(off), 0.06 * static_cast<double>(created));
 }
 
 }  // namespace

@@ -33,6 +33,16 @@ class RotationHistogram {
     }
     return out;
   }
+  // The entries of `matches` that pass, for matches added with their position there as id.
+  template <class T>
+  std::vector<T> kept(const std::vector<T>& matches) const {
+    std::vector<bool> drop(matches.size(), false);
+    for (int k : rejected()) drop[static_cast<size_t>(k)] = true;
+    std::vector<T> out;
+    for (size_t k = 0; k < matches.size(); ++k)
+      if (!drop[k]) out.push_back(matches[k]);
+    return out;
+  }
 
  private:
   size_t size(int bin) const { return bins_[static_cast<size_t>(bin)].size(); }

@@ -36,6 +36,10 @@ class LocalMapper {
   void insert(Map& map, KeyFrame& kf);
   void cullRecentPoints(Map& map, const KeyFrame& kf);
   void triangulateNewPoints(Map& map, KeyFrame& kf);
+  // Candidate pairs (kf keypoint, nb keypoint), both free, for new points: on the epipolar band
+  // of the relative pose T21 (kf frame -> nb frame), by descriptor.
+  std::vector<std::pair<int, int>> epipolarPairs(const KeyFrame& kf, const KeyFrame& nb,
+                                                 const Eigen::Isometry3d& T21) const;
   void fuse(Map& map, KeyFrame& kf);
   // Local BA in three steps so that the solve runs without the map lock: tracking keeps going
   // while it optimizes copies of the poses and points.

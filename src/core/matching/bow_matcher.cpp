@@ -10,12 +10,14 @@ namespace hiveslam::core {
 namespace {
 
 // For every node shared by the two feature vectors, each usable feature of side A takes its
-// nearest usable feature of side B. Returns (a, b) pairs after the ratio and rotation tests.
-template <typename UsableA, typename UsableB>
+// nearest usable feature of side B among those `compatible` with it. Returns (a, b) pairs after
+// the ratio and rotation tests.
+template <typename UsableA, typename UsableB, typename Compatible>
 std::vector<std::pair<int, int>> matchByNodes(const place::FeatureVector& fa, const cv::Mat& da,
                                               const std::vector<cv::KeyPoint>& ka, UsableA usable_a,
                                               const place::FeatureVector& fb, const cv::Mat& db,
-                                              const std::vector<cv::KeyPoint>& kb, UsableB usable_b, double ratio) {
+                                              const std::vector<cv::KeyPoint>& kb, UsableB usable_b,
+                                              Compatible compatible, double ratio) {
   std::vector<int> taken_b(static_cast<size_t>(db.rows), 0);
   std::vector<std::pair<int, int>> pairs;
   features::RotationHistogram hist;
@@ -34,7 +36,7 @@ std::vector<std::pair<int, int>> matchByNodes(const place::FeatureVector& fa, co
       if (!usable_a(i)) continue;
       features::NearestTwo near;
       for (int j : ib->second)
-        if (usable_b(j) && !taken_b[static_cast<size_t>(j)]) near.offer(features::hamming(da.ptr<uchar>(i), db.ptr<uchar>(j)), j);
+        if (usable_b(j) && !taken_b[static_cast<size_t>(j)] && compatible(i, j)) near.offer(features::hamming(da.ptr<uchar>(i), db.ptr<uchar>(j)), j);
       if (!near.accepted(kMatchLow, ratio)) continue;
       const int best_j = near.index;
       taken_b[static_cast<size_t>(best_j)] = 1;
@@ -44,25 +46,32 @@ std::vector<std::pair<int, int>> matchByNodes(const place::FeatureVector& fa, co
     ++ia;
     ++ib;
   }
-  std::vector<bool> rejected(pairs.size(), false);
-  for (int k : hist.rejected()) rejected[static_cast<size_t>(k)] = true;
-  std::vector<std::pair<int, int>> out;
-  for (size_t k = 0; k < pairs.size(); ++k)
-    if (!rejected[k]) out.push_back(pairs[k]);
-  return out;
+  return hist.kept(pairs);
 }
+
+auto hasPoint(const KeyFrame& kf) {
+  return [&kf](int i) {
+    const auto& p = kf.points[static_cast<size_t>(i)];
+    return p && !p->bad;
+  };
+}
+
+constexpr auto anyPair = [](int, int) { return true; };
 
 }  // namespace
 
 std::vector<std::pair<int, int>> matchKeyframesByBow(const KeyFrame& a, const KeyFrame& b, double ratio) {
-  auto has_point = [](const KeyFrame& kf) {
-    return [&kf](int i) {
-      const auto& p = kf.points[static_cast<size_t>(i)];
-      return p && !p->bad;
-    };
+  return matchByNodes(a.bow_features, a.frame.descriptors, a.frame.keypoints, hasPoint(a), b.bow_features,
+                      b.frame.descriptors, b.frame.keypoints, hasPoint(b), anyPair, ratio);
+}
+
+std::vector<std::pair<int, int>> matchUnmappedByBow(const KeyFrame& a, const KeyFrame& b,
+                                                    const std::function<bool(int, int)>& compatible, double ratio) {
+  auto no_point = [](const KeyFrame& kf) {
+    return [&kf](int i) { return !kf.points[static_cast<size_t>(i)]; };
   };
-  return matchByNodes(a.bow_features, a.frame.descriptors, a.frame.keypoints, has_point(a), b.bow_features,
-                      b.frame.descriptors, b.frame.keypoints, has_point(b), ratio);
+  return matchByNodes(a.bow_features, a.frame.descriptors, a.frame.keypoints, no_point(a), b.bow_features,
+                      b.frame.descriptors, b.frame.keypoints, no_point(b), compatible, ratio);
 }
 
 std::vector<int> matchFrameByBow(const Frame& frame, const place::FeatureVector& frame_features, const KeyFrame& kf,
@@ -70,12 +79,7 @@ std::vector<int> matchFrameByBow(const Frame& frame, const place::FeatureVector&
   std::vector<int> out(frame.size(), -1);
   const auto pairs = matchByNodes(
       frame_features, frame.descriptors, frame.keypoints, [](int) { return true; }, kf.bow_features,
-      kf.frame.descriptors, kf.frame.keypoints,
-      [&kf](int j) {
-        const auto& p = kf.points[static_cast<size_t>(j)];
-        return p && !p->bad;
-      },
-      ratio);
+      kf.frame.descriptors, kf.frame.keypoints, hasPoint(kf), anyPair, ratio);
   for (const auto& [i, j] : pairs) out[static_cast<size_t>(i)] = j;
   return out;
 }
