@@ -64,6 +64,7 @@ void applySlamSettings(const std::filesystem::path& file, core::SlamSettings& s)
       {"lost_frames_before_new_map", set(s.lost_frames_before_new_map)},
       {"triangulation_neighbours", set(s.triangulation_neighbours)},
       {"triangulation_max_cos_parallax", set(s.triangulation_max_cos_parallax)},
+      {"triangulation_by_vocabulary", set(s.triangulation_by_vocabulary)},
       {"fusion_neighbours", set(s.fusion_neighbours)},
       {"local_ba_iterations", set(s.local_ba_iterations)},
       {"redundant_keyframe_ratio", set(s.redundant_keyframe_ratio)},

@@ -135,11 +135,10 @@ std::vector<std::pair<int, int>> LocalMapper::epipolarPairs(const KeyFrame& kf, 
     const double s2 = scales_[static_cast<size_t>(nb.frame.keypoints[static_cast<size_t>(j)].octave)];
     return e * e / l2.head<2>().squaredNorm() <= 3.84 * s2 * s2;
   };
-  // Features under the same vocabulary node only, as ORB-SLAM does: far fewer comparisons than
-  // the whole band and fewer false matches (sequential runs at twelve feature budgets: sweep
-  // median 8.9 -> 5.2 mm, CPU about -25%; docs/BENCHMARKS.md, session 13).
-  if (!kf.bow_features.empty() && !nb.bow_features.empty()) return matchUnmappedByBow(kf, nb, on_band, 0.7);
-  // Without a vocabulary: every free pair on the band.
+  // Features under the same vocabulary node only (far fewer comparisons, fewer points; see
+  // SlamSettings::triangulation_by_vocabulary), or every free pair on the band.
+  if (settings_.triangulation_by_vocabulary && !kf.bow_features.empty() && !nb.bow_features.empty())
+    return matchUnmappedByBow(kf, nb, on_band, 0.7);
   std::vector<int> taken(nb.points.size(), 0);
   std::vector<std::pair<int, int>> pairs;
   features::RotationHistogram hist;

@@ -35,6 +35,13 @@ struct SlamSettings {
   // docs/BENCHMARKS.md, session 10.
   int triangulation_neighbours = 10;
   double triangulation_max_cos_parallax = 0.9998;  // new points need a wider angle (1.15 deg)
+  // Candidates for new points only under the same vocabulary node (ORB-SLAM's way) instead of
+  // along the whole epipolar band. Sequential runs at twelve feature budgets: sweep median 8.9
+  // -> 5.2 mm, blackout 9.4 -> 6.0, CPU -25%; but about 12% fewer points, and in the real-time
+  // bench the 3-node outlier rule failed on three sequences (one TR lost figure8's fast turn,
+  // short of points) where it had held on all four: off until two benches say otherwise
+  // (docs/BENCHMARKS.md, session 13).
+  bool triangulation_by_vocabulary = false;
   int fusion_neighbours = 10;
   int local_ba_iterations = 10;
   // A keyframe goes when this share of its points is seen by 3 others at the same or a finer
