@@ -129,11 +129,18 @@ std::vector<std::pair<int, int>> LocalMapper::epipolarPairs(const KeyFrame& kf, 
   Eigen::Matrix3d Km;
   Km << K.fx, 0, K.cx, 0, K.fy, K.cy, 0, 0, 1;
   const Eigen::Matrix3d F21 = Km.inverse().transpose() * skew(T21.translation()) * T21.linear() * Km.inverse();
+  // Each free keypoint's epipolar line in nb, scaled to give distances in pixels: computed once,
+  // tested against every candidate.
+  std::vector<Eigen::Vector3d> lines(kf.points.size(), Eigen::Vector3d::Zero());
+  for (size_t i = 0; i < kf.points.size(); ++i)
+    if (!kf.points[i]) {
+      const Eigen::Vector3d l2 = F21 * kf.frame.points[i].homogeneous();
+      lines[i] = l2 / std::max(l2.head<2>().norm(), 1e-12);
+    }
   auto on_band = [&](int i, int j) {
-    const Eigen::Vector3d l2 = F21 * kf.frame.points[static_cast<size_t>(i)].homogeneous();
-    const double e = nb.frame.points[static_cast<size_t>(j)].homogeneous().dot(l2);
+    const double e = nb.frame.points[static_cast<size_t>(j)].homogeneous().dot(lines[static_cast<size_t>(i)]);
     const double s2 = scales_[static_cast<size_t>(nb.frame.keypoints[static_cast<size_t>(j)].octave)];
-    return e * e / l2.head<2>().squaredNorm() <= 3.84 * s2 * s2;
+    return e * e <= 3.84 * s2 * s2;
   };
   // Features under the same vocabulary node only (far fewer comparisons, fewer points; see
   // SlamSettings::triangulation_by_vocabulary), or every free pair on the band.
