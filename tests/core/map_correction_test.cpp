@@ -91,6 +91,44 @@ TEST(MapCorrection, CulledKeyframesFollowARigidCorrectionWithMovedPoints) { cull
 
 TEST(MapCorrection, CulledKeyframesFollowASimilarityCorrection) { culledKeyframesFollowAScaledMove(false); }
 
+// A global BA solves on copies without the lock. Meanwhile a local BA moves keyframe 4, and local
+// mapping makes keyframe 5 (a child of 4) and a point of its own, posed on 4 where it is now.
+// When the global BA lands, 5 and the point must keep their place relative to 4 as it was then,
+// not as it was when the copies were taken (that baked each such local BA into the children).
+TEST(MapCorrection, WhatIsMadeDuringAGlobalBaFollowsItsParentFromWhereItIsNow) {
+  Corridor c;
+  KeyFrame* kf4 = c.kfs[4].get();
+  KeyFrame* kf5 = c.kfs[5].get();
+  if (kf5->parent) kf5->parent->children.erase(kf5);
+  kf5->parent = kf4;
+  kf4->children.insert(kf5);
+  // Seen by 4 and 5 (slot 0 is free in both): it moves with 4, its oldest observer.
+  auto fresh = std::make_shared<MapPoint>(5000, Eigen::Vector3d(1.5, 0.1, 3.5), 1);
+  c.map.add(fresh);
+  Map::observe(*kf4, 0, fresh);
+  Map::observe(*kf5, 0, fresh);
+  // The copies: keyframes 0-4 as they are now.
+  PoseCorrection correction;
+  const Sim3 S = {Eigen::Quaterniond(Eigen::AngleAxisd(0.2, Eigen::Vector3d(0, 1, 1).normalized())),
+                  Eigen::Vector3d(0.3, -0.2, 0.5), 1.0};
+  for (int k = 0; k <= 4; ++k) {
+    correction.before[c.kfs[k].get()] = Sim3(c.kfs[k]->T_cw);
+    correction.after[c.kfs[k].get()] = Sim3(moved(c.kfs[k]->T_cw, S));
+  }
+  // The local BA lands: keyframe 4 moves; keyframe 5 and the point were posed on it after.
+  Eigen::Isometry3d delta = Eigen::Isometry3d::Identity();
+  delta.linear() = Eigen::AngleAxisd(0.01, Eigen::Vector3d::UnitY()).toRotationMatrix();
+  delta.translation() = Eigen::Vector3d(0.02, -0.01, 0.03);
+  kf4->T_cw = delta * kf4->T_cw;
+  const Eigen::Isometry3d T_54 = kf5->T_cw * kf4->T_cw.inverse();
+  const Eigen::Vector3d fresh_in_4 = kf4->T_cw * fresh->position;
+  applyCorrection(c.map, correction, {1.0});
+
+  expectPose(moved(correction.before.at(kf4).toPose(), S), kf4->T_cw, "keyframe 4 takes the global BA's pose");
+  expectPose(T_54, kf5->T_cw * kf4->T_cw.inverse(), "keyframe 5 relative to 4");
+  EXPECT_LT((kf4->T_cw * fresh->position - fresh_in_4).norm(), 1e-9) << "the new point relative to 4";
+}
+
 TEST(MapCorrection, ACulledKeyframeFollowsItsClosestNeighbourNotADistantParent) {
   Corridor c;
   // Keyframe 5's spanning tree parent is made the far origin; it shares the most points with 4.

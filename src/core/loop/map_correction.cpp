@@ -33,7 +33,14 @@ void applyCorrection(Map& map, const PoseCorrection& c, const std::vector<double
   // Correction of every keyframe, live or retired: old world -> new world.
   std::unordered_map<KeyFrame*, Sim3> moves;
   for (const auto& [kf, after] : c.after) {
-    const Sim3& before = c.before.at(kf);
+    // The optimization started from `before`, but it ran without the lock: local mapping may
+    // have moved the keyframe since, and posed new keyframes and points on it where it is now.
+    // What it carries moves from where it is now (with the optimization's scale), or each
+    // local BA that landed during a global BA would be baked into its children as an error.
+    const Sim3& started = c.before.at(kf);
+    const Sim3 before = kf->bad ? started
+                                : Sim3(Eigen::Quaterniond(kf->T_cw.linear()), started.s * kf->T_cw.translation(),
+                                       started.s);
     moves[kf] = after.inverse() * Sim3(Eigen::Quaterniond::Identity(), Eigen::Vector3d::Zero(),
                                        c.points.empty() ? 1.0 : scaleChange(*kf, before, after, c.points)) * before;
   }
