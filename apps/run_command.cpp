@@ -169,6 +169,8 @@ RunSummary runSlam(const RunOptions& o) {
     if (!node->finishRun(std::chrono::seconds(120)))
       fmt::print(stderr, "warning: the end-of-run exchange did not complete; the maps may differ between nodes\n");
     node_report = node->report(monitor.wallSeconds());
+  } else {
+    slam.drain();  // the end of the run: the last keyframes mapped, the final global BA
   }
   // Before the threads end: a thread that has ended is no longer in /proc.
   const auto thread_cpu = eval::ResourceMonitor::threadCpuSeconds();

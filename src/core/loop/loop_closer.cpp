@@ -437,7 +437,7 @@ void LoopCloser::optimizeEssentialGraph(Map& map, const LoopCorrection& c, LoopE
   event.essential_graph_ms = msSince(t0);
 }
 
-void LoopCloser::globalBundleAdjustment(Map& map) {
+void LoopCloser::globalBundleAdjustment(Map& map, int iterations) {
   const auto t0 = std::chrono::steady_clock::now();
   BaProblem ba;
   std::vector<KeyFrame*> kfs;
@@ -479,7 +479,7 @@ void LoopCloser::globalBundleAdjustment(Map& map) {
   PoseCorrection correction;
   for (size_t i = 0; i < kfs.size(); ++i) correction.before[kfs[i]] = Sim3(ba.poses[i].q_cw, ba.poses[i].t_cw, 1.0);
   BaOptions o;
-  o.iterations = settings_.global_ba_iterations;
+  o.iterations = iterations > 0 ? iterations : settings_.global_ba_iterations;
   o.outlier_round = false;
   bundleAdjust(ba, o);
   for (size_t i = 0; i < kfs.size(); ++i) correction.after[kfs[i]] = Sim3(ba.poses[i].q_cw, ba.poses[i].t_cw, 1.0);

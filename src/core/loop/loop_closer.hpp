@@ -65,6 +65,10 @@ class LoopCloser {
   void setActiveMap(const std::atomic<Map*>* active) { active_ = active; }
   // Called on the loop closing thread, without any lock, after each global update is applied.
   void setOnGlobalUpdate(std::function<void(const GlobalUpdate&)> f) { on_update_ = std::move(f); }
+  // A global BA of `map` with `iterations` (0: global_ba_iterations), reported as a global
+  // update; the end of a run asks for one (SlamSystem::drain). On the loop closing thread, or
+  // where no other module runs; the caller holds no lock.
+  void globalBundleAdjustment(Map& map, int iterations = 0);
 
  private:
   // A recognized place with its covisibility group (keyframe ids), for the consistency test.
@@ -86,7 +90,6 @@ class LoopCloser {
   LoopCorrection correctLoop(Map& map, KeyFrame& kf, const Verified& v);
   void mergeMaps(Map& map, KeyFrame& kf, Map& other, const Verified& v);
   void optimizeEssentialGraph(Map& map, const LoopCorrection& c, LoopEvent& event);
-  void globalBundleAdjustment(Map& map);
 
   SlamSettings settings_;
   KeyframeDatabase& database_;

@@ -70,7 +70,10 @@ void SlamSystem::finish() {
 
 void SlamSystem::loopLoop() {
   while (auto job = loop_jobs_.pop()) {
-    closer_.process(job->map, job->keyframe);
+    if (job->keyframe)
+      closer_.process(job->map, job->keyframe);
+    else
+      closer_.globalBundleAdjustment(*job->map->resolve(), settings_.final_global_ba_iterations);
     --loop_jobs_pending_;
   }
 }
@@ -125,11 +128,22 @@ std::vector<std::shared_ptr<Map>> SlamSystem::maps() const {
 }
 
 void SlamSystem::drain() {
-  if (mode_ == Mode::Sequential) return;
-  {
+  if (mode_ != Mode::Sequential) {
     std::unique_lock lock(idle_mutex_);
     idle_cv_.wait(lock, [&] { return jobs_done_ == jobs_pushed_; });
   }
+  // Everything is mapped: the last global BA, where loop closing runs, so that its result
+  // reaches the other nodes as every global update does.
+  const bool final_ba = settings_.loop_closing && hosting_loop_closing_ && settings_.final_global_ba_iterations > 0;
+  if (final_ba && !final_ba_done_.exchange(true))
+    for (const auto& map : liveMaps()) {
+      if (mode_ == Mode::Sequential) {
+        closer_.globalBundleAdjustment(*map, settings_.final_global_ba_iterations);
+      } else {
+        ++loop_jobs_pending_;
+        loop_jobs_.push({map, nullptr});
+      }
+    }
   while (loop_jobs_pending_ > 0) std::this_thread::sleep_for(std::chrono::milliseconds(5));
 }
 

@@ -80,7 +80,10 @@ class SlamSystem {
   KeyframeDatabase& database() { return database_; }
   const std::vector<double>& scales() const { return extractor_.scales(); }
   const place::Vocabulary* vocabulary() const { return vocabulary_.get(); }
-  // Blocks until the queued keyframes of the hosted modules are done (end of a run).
+  // The end of a run: blocks until the queued keyframes of the hosted modules are done, then,
+  // where loop closing is hosted, runs the final global BA of every map
+  // (SlamSettings::final_global_ba_iterations) on the loop closing thread and waits for it.
+  // Only the first call does the final BA.
   void drain();
 
   const std::vector<FrameRecord>& frames() const { return records_; }
@@ -116,10 +119,11 @@ class SlamSystem {
   std::function<bool()> remote_idle_;
   std::function<void()> remote_wait_;
   std::atomic<int> loop_jobs_pending_{0};
+  std::atomic<bool> final_ba_done_{false};
 
   struct MappingJob {
     std::shared_ptr<Map> map;
-    std::shared_ptr<KeyFrame> keyframe;
+    std::shared_ptr<KeyFrame> keyframe;  // for loop closing, none: the map's final global BA
   };
   void mappingLoop();
   // What local mapping calls before its local BA: the keyframeTriangulated event, if anyone listens.
