@@ -162,6 +162,26 @@ TEST(SlamSystem, RelocalizesAfterAJumpBackWithoutLoopClosing) {
   EXPECT_GE(slam.failures(), 1);
 }
 
+// The end of a run (drain) brings one last global BA of each map, on the loop closing thread once
+// every keyframe is mapped; a second drain brings none, and the setting at 0 switches it off.
+TEST(SlamSystem, TheEndOfARunBringsOneFinalGlobalBa) {
+  const Sweep sweep;
+  for (const int iterations : {50, 0}) {
+    SlamSettings settings;
+    settings.global_ba_every_keyframes = 0;  // so that every global BA seen here is the final one
+    settings.final_global_ba_iterations = iterations;
+    SlamSystem slam(settings, sweep.camera, SlamSystem::Mode::Offline, shippedVocabulary());
+    double t = 0;
+    for (int f = 0; f < 100; ++f) slam.process(sweep.model.renderImage(f, sweep.rays), t += 0.05);
+    ASSERT_EQ(slam.liveMaps().size(), 1u);
+    slam.drain();
+    EXPECT_EQ(slam.loopStats().global_bas, iterations > 0 ? 1 : 0) << iterations << " iterations";
+    slam.drain();
+    EXPECT_EQ(slam.loopStats().global_bas, iterations > 0 ? 1 : 0) << "after a second drain";
+    slam.finish();
+  }
+}
+
 TEST(SlamSystem, SequentialModeIsDeterministic) {
   const SlamRun a = runSequence("sweep", 600, 100, 80, 4, SlamSystem::Mode::Sequential), b = runSequence("sweep", 600, 100, 80, 4, SlamSystem::Mode::Sequential);
   ASSERT_EQ(a.estimate.size(), b.estimate.size());
