@@ -92,7 +92,7 @@ TEST(MapCorrection, CulledKeyframesFollowARigidCorrectionWithMovedPoints) { cull
 TEST(MapCorrection, CulledKeyframesFollowASimilarityCorrection) { culledKeyframesFollowAScaledMove(false); }
 
 // A global BA solves on copies without the lock. Meanwhile a local BA moves keyframe 4, and local
-// mapping makes keyframe 5 (a child of 4) and a point of its own, posed on 4 where it is now.
+// mapping makes keyframe 5 (a child of 4) and a new point, both posed on 4 where it is now.
 // When the global BA lands, 5 and the point must keep their place relative to 4 as it was then,
 // not as it was when the copies were taken (that baked each such local BA into the children).
 TEST(MapCorrection, WhatIsMadeDuringAGlobalBaFollowsItsParentFromWhereItIsNow) {

@@ -7,6 +7,7 @@
 #include <map>
 #include <mutex>
 #include <string>
+#include <vector>
 
 #include "core/camera/pinhole_radtan.hpp"
 #include "core/system/slam_system.hpp"
@@ -166,13 +167,15 @@ TEST(SlamSystem, RelocalizesAfterAJumpBackWithoutLoopClosing) {
 // every keyframe is mapped; a second drain brings none, and the setting at 0 switches it off.
 TEST(SlamSystem, TheEndOfARunBringsOneFinalGlobalBa) {
   const Sweep sweep;
+  std::vector<cv::Mat> images;
+  for (int f = 0; f < 100; ++f) images.push_back(sweep.model.renderImage(f, sweep.rays));
   for (const int iterations : {50, 0}) {
     SlamSettings settings;
     settings.global_ba_every_keyframes = 0;  // so that every global BA seen here is the final one
     settings.final_global_ba_iterations = iterations;
     SlamSystem slam(settings, sweep.camera, SlamSystem::Mode::Offline, shippedVocabulary());
     double t = 0;
-    for (int f = 0; f < 100; ++f) slam.process(sweep.model.renderImage(f, sweep.rays), t += 0.05);
+    for (const auto& image : images) slam.process(image, t += 0.05);
     ASSERT_EQ(slam.liveMaps().size(), 1u);
     slam.drain();
     EXPECT_EQ(slam.loopStats().global_bas, iterations > 0 ? 1 : 0) << iterations << " iterations";

@@ -134,7 +134,7 @@ void SlamSystem::drain() {
   }
   // Everything is mapped: the last global BA, where loop closing runs, so that its result
   // reaches the other nodes as every global update does.
-  const bool final_ba = settings_.loop_closing && hosting_loop_closing_ && settings_.final_global_ba_iterations > 0;
+  const bool final_ba = hosting_loop_closing_ && settings_.final_global_ba_iterations > 0;
   if (final_ba && !final_ba_done_.exchange(true))
     for (const auto& map : liveMaps()) {
       if (mode_ == Mode::Sequential) {
