@@ -13,6 +13,14 @@ struct DistributionSettings {
   // A point's position goes out again in a local map only when it moved more than this (map
   // units: the first two keyframes set the scale, median depth 1). Global maps send all.
   double min_point_move = 1e-4;
+  // A point's full record (descriptor, viewing direction, distance range: what matching uses)
+  // goes again only when its descriptor changed in more than point_descriptor_bits bits, its
+  // direction turned more than point_normal_deg or its distance range changed by more than
+  // point_range_ratio. Sent whenever its observers changed, these records were half of TR's
+  // incoming bytes on bigloop.
+  int point_descriptor_bits = 10;
+  double point_normal_deg = 3.0;
+  double point_range_ratio = 0.03;
   // Global maps (loop closure, merge, global BA): the whole map in batches.
   int global_batch = 10;
   int global_batch_gap_ms = 100;

@@ -67,7 +67,7 @@ void KeyframePublisher::publish(const Job& job) {
       for (const auto& p : k->points)
         if (p && !p->bad && !known_(job.topic, p->id)) {
           m.points.push_back(capturePoint(*p, true));
-          ledger_.mark(job.topic, p->id, static_cast<int>(p->observations.size()));
+          ledger_.mark(job.topic, m.points.back());
         }
     // Tracking's counts for points made since the last few keyframes (local mapping's
     // candidates for culling), found among the keyframe's neighbours.

@@ -302,7 +302,8 @@ void MapHandler::trimForSending(MapRecord& m, Topic topic, bool full) {
   std::vector<PointRecord> kept;
   kept.reserve(m.points.size());
   for (auto& p : m.points) {
-    const bool due = ledger_.needsFull(topic, p.id, p.observations);
+    const bool due = ledger_.needsFull(
+        topic, p, {settings_.point_normal_deg, settings_.point_range_ratio, settings_.point_descriptor_bits});
     const bool moved = ledger_.moved(topic, p.id, p.position, settings_.min_point_move);
     if (!due && !full) {
       // A position update only when it moved: local BA leaves most of a window's points where

@@ -29,7 +29,6 @@ PointRecord capturePoint(const core::MapPoint& p, bool full) {
   PointRecord r;
   r.id = p.id;
   r.position = p.position;
-  r.observations = static_cast<int>(p.observations.size());
   r.full = full;
   if (full) {
     r.first_keyframe = p.first_keyframe;

@@ -104,6 +104,9 @@ void applyDistributionSettings(const std::filesystem::path& file, distribution::
       {"local_batch_gap_ms", set(s.local_batch_gap_ms)},
       {"local_window", set(s.local_window)},
       {"min_point_move", set(s.min_point_move)},
+      {"point_descriptor_bits", set(s.point_descriptor_bits)},
+      {"point_normal_deg", set(s.point_normal_deg)},
+      {"point_range_ratio", set(s.point_range_ratio)},
       {"global_batch", set(s.global_batch)},
       {"global_batch_gap_ms", set(s.global_batch_gap_ms)},
       {"remote_mapping_wait_ms", set(s.remote_mapping_wait_ms)},
@@ -111,6 +114,7 @@ void applyDistributionSettings(const std::filesystem::path& file, distribution::
   apply(file, section, keys, "distribution.");
   if (s.local_first_batch < 1 || s.local_max_batch < s.local_first_batch || s.global_batch < 1 ||
       s.local_batch_gap_ms < 0 || s.global_batch_gap_ms < 0 || s.local_window < 1 || s.min_point_move < 0 ||
+      s.point_descriptor_bits < 0 || s.point_normal_deg < 0 || s.point_range_ratio < 0 ||
       s.remote_mapping_wait_ms < 0)
     throw InputError(file.string() + ": distribution settings out of range (batches >= 1, first <= max, times >= 0)");
 }

@@ -18,14 +18,13 @@ using core::kNoId;
 struct PointRecord {
   Id id = kNoId;
   Eigen::Vector3d position = Eigen::Vector3d::Zero();
-  // Full records (the first time a point is sent, and when its observations changed) also carry
+  // Full records (the first time a point is sent, and when these changed: SentLedger) also carry
   // what matching needs: descriptor, viewing direction and distance range.
   bool full = false;
   Id first_keyframe = kNoId;
   std::array<uint8_t, 32> descriptor{};
   Eigen::Vector3d normal = Eigen::Vector3d::Zero();
   double min_distance = 0, max_distance = 0;
-  int observations = 0;  // not sent: lets a sender tell when the full record is due again
 };
 
 struct KeyFrameRecord {
