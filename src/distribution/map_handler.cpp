@@ -301,9 +301,10 @@ void MapHandler::sendLocalBatch(Outgoing& o) {
 void MapHandler::trimForSending(MapRecord& m, Topic topic, bool full) {
   std::vector<PointRecord> kept;
   kept.reserve(m.points.size());
+  const AppearanceTolerance tolerance{settings_.point_normal_deg, settings_.point_range_ratio,
+                                      settings_.point_descriptor_bits};
   for (auto& p : m.points) {
-    const bool due = ledger_.needsFull(
-        topic, p, {settings_.point_normal_deg, settings_.point_range_ratio, settings_.point_descriptor_bits});
+    const bool due = ledger_.needsFull(topic, p, tolerance);
     const bool moved = ledger_.moved(topic, p.id, p.position, settings_.min_point_move);
     if (!due && !full) {
       // A position update only when it moved: local BA leaves most of a window's points where

@@ -5,12 +5,12 @@
 // data changed enough to matter. Thread-safe.
 #include <Eigen/Core>
 #include <array>
-#include <bit>
 #include <cmath>
 #include <mutex>
 #include <unordered_map>
 
 #include "communication/message.hpp"
+#include "core/features/hamming.hpp"
 #include "core/map/ids.hpp"
 #include "distribution/wire/records.hpp"
 
@@ -38,10 +38,7 @@ class SentLedger {
     if (inserted) return true;
     const Held& held = it->second;
     const double cos_turn = held.normal.dot(p.normal);
-    int bits = 0;
-    for (size_t i = 0; i < p.descriptor.size(); ++i)
-      bits += std::popcount(static_cast<uint8_t>(held.descriptor[i] ^ p.descriptor[i]));
-    const bool same = bits <= tolerance.descriptor_bits &&
+    const bool same = features::hamming(held.descriptor.data(), p.descriptor.data()) <= tolerance.descriptor_bits &&
                       cos_turn >= std::cos(tolerance.normal_deg * M_PI / 180.0) * held.normal.norm() * p.normal.norm() &&
                       std::abs(p.max_distance - held.max_distance) <= tolerance.range_ratio * held.max_distance &&
                       std::abs(p.min_distance - held.min_distance) <= tolerance.range_ratio * held.min_distance;
