@@ -138,5 +138,44 @@ TEST(MapCorrection, ACulledKeyframeFollowsItsClosestNeighbourNotADistantParent) 
   EXPECT_EQ(c.kfs[5]->anchor, c.kfs[4].get());
 }
 
+
+// After a merge the absorbed map's origin is a root without a parent and no longer the origin:
+// the node that merged can cull it, and the global map it then sends leaves it out. Where that
+// map arrives, the keyframe (and the frames tracking posed from it) must move with its
+// neighbours, not stay in the absorbed map's old frame.
+void aRootLeftOutOfTheCorrectionMovesWithItsNeighbours(bool rigid) {
+  Corridor c;
+  KeyFrame* root = c.kfs[0].get();
+  ASSERT_EQ(root->parent, nullptr);
+  c.map.origin = c.kfs[5].get();  // the map that absorbed it has its own origin
+  Eigen::Isometry3d T_frame = root->T_cw;
+  T_frame.translation() += Eigen::Vector3d(0.03, -0.01, 0.02);
+  const RelativePose frame = root->relative(T_frame);
+  const Eigen::Isometry3d T_root = root->T_cw;
+  const Sim3 S = someSimilarity();
+  PoseCorrection correction;
+  for (const auto& [id, kf] : c.map.keyframes) {
+    if (kf.get() == root) continue;
+    correction.before[kf.get()] = Sim3(kf->T_cw);
+    correction.after[kf.get()] = rigid ? Sim3(moved(kf->T_cw, S)) : Sim3(kf->T_cw) * S.inverse();
+  }
+  if (rigid)
+    for (const auto& [id, p] : c.map.points) correction.points[p.get()] = S * p->position;
+  applyCorrection(c.map, correction, {1.0});
+  expectPose(moved(T_root, S), root->pose(), "the root");
+  expectPose(moved(T_frame, S), root->poseOf(frame), "a frame posed from it");
+  // Culled here afterwards (the sender no longer has it), it stays where it now is.
+  c.map.erase(*root);
+  expectPose(moved(T_root, S), root->pose(), "the culled root");
+}
+
+TEST(MapCorrection, AMergedMapsRootLeftOutOfARigidCorrectionMovesWithItsNeighbours) {
+  aRootLeftOutOfTheCorrectionMovesWithItsNeighbours(true);
+}
+
+TEST(MapCorrection, AMergedMapsRootLeftOutOfASimilarityCorrectionMovesWithItsNeighbours) {
+  aRootLeftOutOfTheCorrectionMovesWithItsNeighbours(false);
+}
+
 }  // namespace
 }  // namespace hiveslam::core

@@ -1,6 +1,7 @@
 #include "core/loop/map_correction.hpp"
 
 #include <algorithm>
+#include <unordered_set>
 #include <vector>
 
 #include "core/map/map_point.hpp"
@@ -44,15 +45,31 @@ void applyCorrection(Map& map, const PoseCorrection& c, const std::vector<double
     moves[kf] = after.inverse() * Sim3(Eigen::Quaterniond::Identity(), Eigen::Vector3d::Zero(),
                                        c.points.empty() ? 1.0 : scaleChange(*kf, before, after, c.points)) * before;
   }
+  auto next = [](KeyFrame* k) -> KeyFrame* {
+    if (k->bad && k->anchor) return k->anchor;
+    if (k->parent) return k->parent;
+    // A keyframe tracking has just made has no parent until local mapping gives it one
+    // (at TR, until a local map says which): it moves with the keyframe it was posed from.
+    if (k->made_from) return k->made_from;
+    // The root of a map merged into this one (its origin) has no parent, and once it is no
+    // longer an origin it can be culled where the correction was made: then the correction
+    // leaves it out, and it moves with the neighbour sharing the most points with it. (Left
+    // where it was, a merge at another node left TR's frames posed from it in the old map's
+    // frame, metres off.)
+    const auto best = k->bestCovisible(1);
+    return best.empty() ? nullptr : best.front();
+  };
   auto correctionOf = [&](KeyFrame* kf) {
     std::vector<KeyFrame*> chain;
+    std::unordered_set<KeyFrame*> seen;  // covisibility can lead back into the chain
     KeyFrame* k = kf;
     while (k && !moves.count(k)) {
+      if (!seen.insert(k).second) {
+        k = nullptr;
+        break;
+      }
       chain.push_back(k);
-      // A keyframe tracking has just made has no parent until local mapping gives it one
-      // (at TR, until a local map says which): it moves with the keyframe it was posed from.
-      k = k->bad && k->anchor ? k->anchor : k->parent ? k->parent : k->made_from;
-      if (chain.size() > 100000) break;  // a broken tree must not hang us
+      k = next(k);
     }
     const Sim3 C = k ? moves.at(k) : Sim3();
     for (KeyFrame* x : chain) moves[x] = C;

@@ -3,10 +3,11 @@
 // keyframe's correction C = S_new^-1 * S_old carries the points it anchors; keyframes the
 // optimization did not see (created meanwhile) inherit the correction of their nearest ancestor
 // in the spanning tree (without a parent yet: of the keyframe tracking posed them from; culled:
-// of their anchor). Rigid poses that come with moved points get the scale change their points
-// show. Each keyframe's scale_change takes its correction's scale, so culled keyframes and
-// tracked frames, held relative to live keyframes (KeyFrame::pose), follow it exactly. The
-// caller holds the map's mutex.
+// of their anchor; the root of a map merged into this one: of its strongest neighbour). Rigid
+// poses that come with moved points get the scale change their points show. Each keyframe's
+// scale_change takes its correction's scale, so culled keyframes and tracked frames, held
+// relative to live keyframes (KeyFrame::pose), follow it exactly. The caller holds the map's
+// mutex.
 #include <unordered_map>
 
 #include "core/geometry/sim3.hpp"
