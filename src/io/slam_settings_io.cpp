@@ -116,7 +116,8 @@ void applyDistributionSettings(const std::filesystem::path& file, distribution::
       s.local_batch_gap_ms < 0 || s.global_batch_gap_ms < 0 || s.local_window < 1 || s.min_point_move < 0 ||
       s.point_descriptor_bits < 0 || s.point_normal_deg < 0 || s.point_range_ratio < 0 ||
       s.remote_mapping_wait_ms < 0)
-    throw InputError(file.string() + ": distribution settings out of range (batches >= 1, first <= max, times >= 0)");
+    throw InputError(file.string() + ": distribution settings out of range (batches and local_window >= 1, first <= max, times, "
+                     "min_point_move and point tolerances >= 0)");
 }
 
 }  // namespace hiveslam::io

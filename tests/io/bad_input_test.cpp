@@ -181,6 +181,8 @@ TEST(BadInput, DistributionSettingsAreReadAndChecked) {
   EXPECT_NE(errorOf([&] { applyDistributionSettings(file, s); }).find("distribution.local_max_bach"), std::string::npos);
   std::ofstream(file) << "distribution:\n  local_first_batch: 9\n  local_max_batch: 4\n";
   EXPECT_NE(errorOf([&] { applyDistributionSettings(file, s); }).find("out of range"), std::string::npos);
+  std::ofstream(file) << "distribution:\n  point_normal_deg: -1\n";
+  EXPECT_NE(errorOf([&] { applyDistributionSettings(file, s); }).find("point tolerances >= 0"), std::string::npos);
   std::ofstream(file) << "distribution:\n  global_batch: ten\n";
   EXPECT_NE(errorOf([&] { applyDistributionSettings(file, s); }).find("wrong type"), std::string::npos);
 }
