@@ -381,22 +381,28 @@ void StateIntegrator::applyGlobal(const std::vector<MapRecord>& batches, bool au
   for (const auto& b : batches) applyErasures(*map, b);
   if (authoritative) {
     // What the sender no longer has (culled or fused while this node was not listening) goes,
-    // except what it could not have known yet when it took the snapshot.
-    const auto newest_kf = newestByNode(kf_ids);
-    const auto newest_point = newestByNode(point_ids);
+    // except what it could not have known yet when it took the snapshot. One rule for the map
+    // and for S_full: keyframes and points share each node's id counter, so an object older
+    // than anything of its node in the snapshot was known to the sender. (The map once judged
+    // points by the snapshot's points alone, S_full by both: a point both rules did not agree
+    // on stayed in the SLAM map only, and LC ended a CI run with one point more than LM.)
+    std::vector<Id> ids = kf_ids;
+    ids.insert(ids.end(), point_ids.begin(), point_ids.end());
+    const auto newest = newestByNode(ids);
+    const auto known_to_sender = [&](Id id) { return olderThanSnapshot(id, newest); };
     const std::unordered_set<Id> kfs(kf_ids.begin(), kf_ids.end()), pts(point_ids.begin(), point_ids.end());
     std::vector<core::KeyFrame*> gone_kfs;
     for (const auto& [id, k] : map->keyframes)
-      if (!kfs.count(id) && olderThanSnapshot(id, newest_kf) && k.get() != map->origin) gone_kfs.push_back(k.get());
+      if (!kfs.count(id) && known_to_sender(id) && k.get() != map->origin) gone_kfs.push_back(k.get());
     for (core::KeyFrame* k : gone_kfs) {
       map->erase(*k);
       slam_.database().erase(k);
     }
     std::vector<core::MapPoint*> gone_points;
     for (const auto& [id, p] : map->points)
-      if (!pts.count(id) && olderThanSnapshot(id, newest_point)) gone_points.push_back(p.get());
+      if (!pts.count(id) && known_to_sender(id)) gone_points.push_back(p.get());
     for (core::MapPoint* p : gone_points) map->erase(*p);
-    observer_.prune(kfs, pts, [&](Id id) { return olderThanSnapshot(id, newest_kf) || olderThanSnapshot(id, newest_point); });
+    observer_.prune(kfs, pts, known_to_sender);
   }
   for (const auto& [id, k] : map->keyframes) k->updateConnections();
   noteEpoch(*map, batches.front().epoch);

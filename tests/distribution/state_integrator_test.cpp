@@ -287,5 +287,38 @@ TEST_F(EpochLabels, ALocalMapAcknowledgesOnlyTheKeyframeMappedNotItsNeighbours) 
   receiver->stop();
 }
 
+
+// An authoritative snapshot (LM's relay) erases what its sender no longer has, judged by the
+// ids it carries: the same objects go from the SLAM map and from S_full. Here the sender has
+// a keyframe (200) made after the last point (129), and no longer that point: it knew of the
+// point, so the point goes from both.
+TEST_F(EpochLabels, AnAuthoritativeSnapshotErasesTheSameObjectsFromTheMapAndFromSFull) {
+  constexpr Id kErased = 100 + kPoints - 1, kNewer = 200;
+  ASSERT_TRUE(pointHere(kErased));
+  ASSERT_TRUE(observer_.hasPoint(kErased));
+  MapRecord g;
+  g.kind = MapRecord::Kind::Global;
+  g.map = kMap;
+  g.epoch = 1;
+  for (Id kf : {kFirst, kSecond, kNewer}) {
+    KeyFrameRecord k;
+    k.id = kf;
+    k.map = kMap;
+    k.links = false;
+    k.T_cw = poseAt(kf == kFirst ? 0.0 : kf == kSecond ? 0.4 : 0.8);
+    g.keyframes.push_back(k);
+  }
+  for (int i = 0; i < kPoints - 1; ++i) {
+    PointRecord p;
+    p.id = 100 + i;
+    p.position = pointAt(i);
+    g.points.push_back(p);
+  }
+  integrator_.applyGlobal({g}, true);
+  EXPECT_FALSE(observer_.hasPoint(kErased));
+  EXPECT_FALSE(pointHere(kErased)) << "erased from S_full but left in the SLAM map";
+  EXPECT_TRUE(pointHere(100));
+}
+
 }  // namespace
 }  // namespace hiveslam::distribution
