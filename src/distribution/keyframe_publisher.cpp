@@ -86,7 +86,7 @@ void KeyframePublisher::publish(const Job& job) {
     if (recent.size() > 4) recent.pop_front();
   }
   observer_.record(m.keyframe);
-  for (const auto& p : m.points) observer_.record(p);
+  for (const auto& p : m.points) observer_.record(p, m.keyframe.map);
   transport_.publish(job.topic, pack(m, node_, job.target, job.map->id, label));
   ++published_;
 }

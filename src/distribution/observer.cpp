@@ -19,9 +19,10 @@ void Observer::record(const KeyFrameRecord& k) {
   stored = std::move(light);
 }
 
-void Observer::record(const PointRecord& p) {
+void Observer::record(const PointRecord& p, Id map) {
   std::lock_guard lock(mutex_);
   if (erased_points_.count(p.id)) return;
+  if (map != kNoId) point_map_[p.id] = map;
   auto it = points_.find(p.id);
   if (it == points_.end() || p.full) {
     points_[p.id] = p;
@@ -31,8 +32,16 @@ void Observer::record(const PointRecord& p) {
 }
 
 void Observer::record(const MapRecord& m) {
+  if (!m.merged_maps.empty()) {
+    std::lock_guard lock(mutex_);
+    const std::unordered_set<Id> merged(m.merged_maps.begin(), m.merged_maps.end());
+    for (auto& [id, k] : keyframes_)
+      if (merged.count(k.map)) k.map = m.map;
+    for (auto& [id, map] : point_map_)
+      if (merged.count(map)) map = m.map;
+  }
   for (const auto& k : m.keyframes) record(k);
-  for (const auto& p : m.points) record(p);
+  for (const auto& p : m.points) record(p, m.map);
   for (Id id : m.erased_keyframes) eraseKeyframe(id);
   for (Id id : m.erased_points) erasePoint(id);
   for (const auto& [old, by] : m.replaced_points) erasePoint(old);
@@ -44,19 +53,28 @@ void Observer::eraseKeyframe(Id id) {
   erased_keyframes_.insert(id);
 }
 
-void Observer::prune(const std::unordered_set<Id>& keyframes, const std::unordered_set<Id>& points,
-                     const std::function<bool(Id)>& known_to_sender) {
+void Observer::prune(const MapRecord& snapshot, const std::unordered_set<Id>& keyframes,
+                     const std::unordered_set<Id>& points, const std::function<bool(Id)>& known_to_sender) {
   std::lock_guard lock(mutex_);
+  std::unordered_set<Id> maps(snapshot.merged_maps.begin(), snapshot.merged_maps.end());
+  maps.insert(snapshot.map);
+  // A point with no map on record (none should be) is judged as before: leaving it could leave
+  // S_full holding what every other node erased.
+  const auto of_snapshot = [&](Id point) {
+    auto m = point_map_.find(point);
+    return m == point_map_.end() || maps.count(m->second) > 0;
+  };
   for (auto it = keyframes_.begin(); it != keyframes_.end();)
-    if (!keyframes.count(it->first) && known_to_sender(it->first)) {
+    if (maps.count(it->second.map) && !keyframes.count(it->first) && known_to_sender(it->first)) {
       erased_keyframes_.insert(it->first);
       it = keyframes_.erase(it);
     } else {
       ++it;
     }
   for (auto it = points_.begin(); it != points_.end();)
-    if (!points.count(it->first) && known_to_sender(it->first)) {
+    if (!points.count(it->first) && known_to_sender(it->first) && of_snapshot(it->first)) {
       erased_points_.insert(it->first);
+      point_map_.erase(it->first);
       it = points_.erase(it);
     } else {
       ++it;
@@ -77,6 +95,7 @@ void Observer::revive(const MapRecord& snapshot) {
 void Observer::erasePoint(Id id) {
   std::lock_guard lock(mutex_);
   points_.erase(id);
+  point_map_.erase(id);
   erased_points_.insert(id);
 }
 

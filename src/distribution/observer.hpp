@@ -23,12 +23,15 @@ struct StateDigest {
 class Observer {
  public:
   void record(const KeyFrameRecord& k);  // frame data is not kept (the core keyframe has it)
-  void record(const PointRecord& p);
-  void record(const MapRecord& m);       // keyframes, points and erasures of one batch
+  void record(const PointRecord& p, Id map);
+  // Keyframes, points and erasures of one batch; the records of maps it lists as merged into
+  // its map belong to that map from now on.
+  void record(const MapRecord& m);
   void eraseKeyframe(Id id);
-  // After an authoritative snapshot: records it lacks that `known` says it should have had
-  // (the sender erased them) go.
-  void prune(const std::unordered_set<Id>& keyframes, const std::unordered_set<Id>& points,
+  // After an authoritative snapshot of `snapshot.map`: records of that map (or of the maps it
+  // absorbed) that the snapshot lacks and that `known` says its sender had go (the sender
+  // erased them). Another map's records are not the snapshot's to judge.
+  void prune(const MapRecord& snapshot, const std::unordered_set<Id>& keyframes, const std::unordered_set<Id>& points,
              const std::function<bool(Id)>& known_to_sender);
   void erasePoint(Id id);
   // Whether the point was erased here (a tombstone: a record from a node that has not heard of
@@ -46,6 +49,7 @@ class Observer {
   mutable std::mutex mutex_;
   std::unordered_map<Id, KeyFrameRecord> keyframes_;
   std::unordered_map<Id, PointRecord> points_;
+  std::unordered_map<Id, Id> point_map_;  // the map each point record came with
   std::unordered_set<Id> erased_keyframes_, erased_points_;
   // Global map batches being collected, by map, for one epoch at a time (a newer epoch drops
   // an unfinished older one).

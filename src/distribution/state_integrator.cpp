@@ -235,7 +235,7 @@ StateIntegrator::Added StateIntegrator::addKeyframe(const KeyFrameMessage& m, ui
         it->second->found = std::max(it->second->found, static_cast<int>(s.found));
       }
   }
-  for (const auto& p : applied) observer_.record(p);
+  for (const auto& p : applied) observer_.record(p, map->id);
   for (const auto& c : m.companions) observer_.record(c);
   KeyFrameRecord placed = m.keyframe;
   placed.T_cw = kf->T_cw;
@@ -302,7 +302,7 @@ void StateIntegrator::applyLocal(const MapRecord& m) {
     // Points no keyframe here can carry come with the sender's next fresh record.
     for (const auto& p : carryNewPoints(*map, m)) {
       applyPoint(*map, p);
-      observer_.record(p);
+      observer_.record(p, m.map);
     }
     applyErasures(*map, m);
     for (Id id : m.erased_keyframes) observer_.eraseKeyframe(id);
@@ -402,7 +402,7 @@ void StateIntegrator::applyGlobal(const std::vector<MapRecord>& batches, bool au
     for (const auto& [id, p] : map->points)
       if (!pts.count(id) && known_to_sender(id)) gone_points.push_back(p.get());
     for (core::MapPoint* p : gone_points) map->erase(*p);
-    observer_.prune(kfs, pts, known_to_sender);
+    observer_.prune(batches.front(), kfs, pts, known_to_sender);
   }
   for (const auto& [id, k] : map->keyframes) k->updateConnections();
   noteEpoch(*map, batches.front().epoch);

@@ -320,5 +320,59 @@ TEST_F(EpochLabels, AnAuthoritativeSnapshotErasesTheSameObjectsFromTheMapAndFrom
   EXPECT_TRUE(pointHere(100));
 }
 
+// Two maps that have not merged (tracking lost the first and began a second): a snapshot of
+// one says nothing about the other. Its sender's newest ids are newer than everything of the
+// other map, so judged by ids alone S_full would lose the other map, here and at every node
+// that took the relay.
+TEST_F(EpochLabels, AnAuthoritativeSnapshotOfOneMapLeavesAnotherMapsRecords) {
+  constexpr Id kOtherMap = 8, kOtherKeyframe = 20, kOtherPoint = 150, kNewer = 200;
+  KeyFrameMessage other;
+  other.keyframe.id = kOtherKeyframe;
+  other.keyframe.map = kOtherMap;
+  other.keyframe.full = true;
+  other.keyframe.frame = featureFrame(2);
+  other.keyframe.T_cw = poseAt(2.0);
+  PointRecord p;
+  p.id = kOtherPoint;
+  p.position = pointAt(3);
+  p.full = true;
+  p.first_keyframe = kOtherKeyframe;
+  other.points.push_back(p);
+  other.keyframe.matches.emplace_back(0, kOtherPoint);
+  ASSERT_TRUE(integrator_.addKeyframe(other, 0).keyframe);
+  ASSERT_TRUE(observer_.hasPoint(kOtherPoint));
+  ASSERT_EQ(observer_.keyframeCount(), 3u);
+
+  MapRecord g;
+  g.kind = MapRecord::Kind::Global;
+  g.map = kMap;
+  g.epoch = 1;
+  for (Id kf : {kFirst, kSecond, kNewer}) {
+    KeyFrameRecord k;
+    k.id = kf;
+    k.map = kMap;
+    k.links = false;
+    k.T_cw = poseAt(kf == kFirst ? 0.0 : kf == kSecond ? 0.4 : 0.8);
+    g.keyframes.push_back(k);
+  }
+  for (int i = 0; i < kPoints - 1; ++i) {
+    PointRecord q;
+    q.id = 100 + i;
+    q.position = pointAt(i);
+    g.points.push_back(q);
+  }
+  integrator_.applyGlobal({g}, true);
+  EXPECT_FALSE(observer_.hasPoint(100 + kPoints - 1)) << "the snapshot's own map is still pruned";
+  EXPECT_TRUE(observer_.hasPoint(kOtherPoint)) << "the other map's point left S_full";
+  EXPECT_EQ(observer_.digest().keyframes.count(kOtherKeyframe), 1u) << "the other map's keyframe left S_full";
+
+  // Once a snapshot says the other map lives in this one, its records are this map's to judge.
+  g.epoch = 2;
+  g.merged_maps = {kOtherMap};
+  integrator_.applyGlobal({g}, true);
+  EXPECT_FALSE(observer_.hasPoint(kOtherPoint));
+  EXPECT_EQ(observer_.digest().keyframes.count(kOtherKeyframe), 0u);
+}
+
 }  // namespace
 }  // namespace hiveslam::distribution
