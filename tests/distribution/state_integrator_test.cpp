@@ -99,6 +99,30 @@ class EpochLabels : public ::testing::Test {
     integrator_.applyGlobal({g}, false);
   }
 
+  // LM's authoritative snapshot of the map at epoch 1: both keyframes, a keyframe `newer` made
+  // since, and every point but the last, which the sender no longer has.
+  static MapRecord snapshotWithoutLastPoint(Id newer) {
+    MapRecord g;
+    g.kind = MapRecord::Kind::Global;
+    g.map = kMap;
+    g.epoch = 1;
+    for (Id kf : {kFirst, kSecond, newer}) {
+      KeyFrameRecord k;
+      k.id = kf;
+      k.map = kMap;
+      k.links = false;
+      k.T_cw = poseAt(kf == kFirst ? 0.0 : kf == kSecond ? 0.4 : 0.8);
+      g.keyframes.push_back(k);
+    }
+    for (int i = 0; i < kPoints - 1; ++i) {
+      PointRecord p;
+      p.id = 100 + i;
+      p.position = pointAt(i);
+      g.points.push_back(p);
+    }
+    return g;
+  }
+
   // LM's local map of epoch 0: the window as it was, and one new point, all in the old frame.
   MapRecord staleLocalMap(const Eigen::Vector3d& new_point, bool with_keyframes = true) const {
     MapRecord m;
@@ -296,25 +320,7 @@ TEST_F(EpochLabels, AnAuthoritativeSnapshotErasesTheSameObjectsFromTheMapAndFrom
   constexpr Id kErased = 100 + kPoints - 1, kNewer = 200;
   ASSERT_TRUE(pointHere(kErased));
   ASSERT_TRUE(observer_.hasPoint(kErased));
-  MapRecord g;
-  g.kind = MapRecord::Kind::Global;
-  g.map = kMap;
-  g.epoch = 1;
-  for (Id kf : {kFirst, kSecond, kNewer}) {
-    KeyFrameRecord k;
-    k.id = kf;
-    k.map = kMap;
-    k.links = false;
-    k.T_cw = poseAt(kf == kFirst ? 0.0 : kf == kSecond ? 0.4 : 0.8);
-    g.keyframes.push_back(k);
-  }
-  for (int i = 0; i < kPoints - 1; ++i) {
-    PointRecord p;
-    p.id = 100 + i;
-    p.position = pointAt(i);
-    g.points.push_back(p);
-  }
-  integrator_.applyGlobal({g}, true);
+  integrator_.applyGlobal({snapshotWithoutLastPoint(kNewer)}, true);
   EXPECT_FALSE(observer_.hasPoint(kErased));
   EXPECT_FALSE(pointHere(kErased)) << "erased from S_full but left in the SLAM map";
   EXPECT_TRUE(pointHere(100));
@@ -343,24 +349,7 @@ TEST_F(EpochLabels, AnAuthoritativeSnapshotOfOneMapLeavesAnotherMapsRecords) {
   ASSERT_TRUE(observer_.hasPoint(kOtherPoint));
   ASSERT_EQ(observer_.keyframeCount(), 3u);
 
-  MapRecord g;
-  g.kind = MapRecord::Kind::Global;
-  g.map = kMap;
-  g.epoch = 1;
-  for (Id kf : {kFirst, kSecond, kNewer}) {
-    KeyFrameRecord k;
-    k.id = kf;
-    k.map = kMap;
-    k.links = false;
-    k.T_cw = poseAt(kf == kFirst ? 0.0 : kf == kSecond ? 0.4 : 0.8);
-    g.keyframes.push_back(k);
-  }
-  for (int i = 0; i < kPoints - 1; ++i) {
-    PointRecord q;
-    q.id = 100 + i;
-    q.position = pointAt(i);
-    g.points.push_back(q);
-  }
+  MapRecord g = snapshotWithoutLastPoint(kNewer);
   integrator_.applyGlobal({g}, true);
   EXPECT_FALSE(observer_.hasPoint(100 + kPoints - 1)) << "the snapshot's own map is still pruned";
   EXPECT_TRUE(observer_.hasPoint(kOtherPoint)) << "the other map's point left S_full";
