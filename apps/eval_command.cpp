@@ -1,11 +1,19 @@
 // hiveslam eval ate|rpe GT EST: trajectory errors with evo's rules, as a table or JSON.
+// hiveslam eval scale-step GT EST and scale-precision ATLAS: a monocular run's scale step
+// between two stretches, and how precisely the map's own measurements could fix it.
 #include <fmt/format.h>
 
 #include <nlohmann/json.hpp>
 
 #include "apps/commands.hpp"
+#include "common/error.hpp"
+#include "eval/scale_precision.hpp"
+#include "eval/scale_step.hpp"
 #include "eval/trajectory_error.hpp"
 #include "eval/trajectory_plot.hpp"
+#include "core/features/orb_extractor.hpp"
+#include "core/optim/map_ba_problem.hpp"
+#include "io/atlas_file.hpp"
 #include "io/trajectory_io.hpp"
 
 namespace hiveslam::apps {
@@ -53,6 +61,20 @@ void printStats(const std::string& title, const eval::ErrorStats& s, const std::
                          {"rmse", s.rmse}, {"sse", s.sse}, {"std", s.std}})
     fmt::print("{:>10}  {:.6f} {}\n", name, v, unit);
   fmt::print("{:>10}  {}\n", "matched", s.count);
+}
+
+void addSplit(CLI::App* cmd, eval::StretchSplit& split) {
+  cmd->add_option("--before", split.before, "First stretch: up to this many seconds into the run")->required();
+  cmd->add_option("--after", split.after, "Second stretch: from this many seconds into the run")->required();
+}
+
+// The map with the most keyframes, or the one asked for.
+std::shared_ptr<core::Map> pickMap(const std::vector<std::shared_ptr<core::Map>>& maps, long id) {
+  std::shared_ptr<core::Map> best;
+  for (const auto& m : maps)
+    if (id >= 0 ? static_cast<long>(m->id) == id : !best || m->keyframes.size() > best->keyframes.size()) best = m;
+  if (!best) throw InputError(id >= 0 ? fmt::format("the atlas has no map {}", id) : "the atlas has no map");
+  return best;
 }
 
 }  // namespace
@@ -111,6 +133,53 @@ void addEvalCommand(CLI::App& app) {
     }
     printStats(fmt::format("RPE, {} part, delta {} {}", *rotation ? "rotation" : "translation", *delta, *unit),
                r.stats, *rotation ? "deg" : "m");
+  });
+
+  auto step = std::make_shared<Common>();
+  auto step_split = std::make_shared<eval::StretchSplit>();
+  auto* step_cmd = eval->add_subcommand("scale-step", "Scale of a later stretch of the run relative to an earlier one");
+  addCommon(step_cmd, *step);
+  addSplit(step_cmd, *step_split);
+  step_cmd->callback([=]() {
+    const Loaded l = load(*step);
+    const auto r = eval::computeScaleStep(l.gt, l.est, *step_split, l.match);
+    if (step->json) {
+      nlohmann::json j{{"step", r.step()}, {"first_scale", r.first_scale}, {"second_scale", r.second_scale},
+                       {"first_poses", r.first_poses}, {"second_poses", r.second_poses}};
+      fmt::print("{}\n", j.dump(2));
+      return;
+    }
+    fmt::print("scale step {:.4f}: stretch up to {} s at {:.4f} of true size ({} poses), from {} s at {:.4f} ({} poses)\n",
+               r.step(), step_split->before, r.first_scale, r.first_poses, step_split->after, r.second_scale,
+               r.second_poses);
+  });
+
+  auto precision = std::make_shared<eval::ScalePrecisionOptions>();
+  auto atlas = std::make_shared<std::string>();
+  auto map_id = std::make_shared<long>(-1);
+  auto* precision_cmd = eval->add_subcommand(
+      "scale-precision", "How precisely a saved map's measurements fix the scale step between two stretches");
+  precision_cmd->add_option("ATLAS", *atlas, "Atlas file (hiveslam run --atlas-out)")->required();
+  addSplit(precision_cmd, precision->split);
+  precision_cmd->add_option("--map", *map_id, "Map id (default: the one with the most keyframes)");
+  precision_cmd->add_option("--noise", precision->noise, "Noise per coordinate in level sigmas (default: the map's residuals)");
+  precision_cmd->add_option("--trials", precision->trials, "Noise draws, each a full bundle adjustment")
+      ->capture_default_str()->check(CLI::Range(2, 1000));
+  precision_cmd->callback([=]() {
+    const auto map = pickMap(io::loadAtlas(*atlas), *map_id);
+    const features::OrbOptions orb;  // the atlas keeps keypoint levels, not the pyramid's factor
+    std::vector<double> scales{1.0};
+    for (int l = 1; l < orb.levels; ++l) scales.push_back(scales.back() * orb.scale_factor);
+    std::lock_guard lock(map->mutex);
+    const core::MapBaProblem whole = core::buildMapBaProblem(*map, scales);
+    std::vector<double> stamps;
+    for (const core::KeyFrame* k : whole.keyframes) stamps.push_back(k->frame.timestamp);
+    const auto r = eval::computeScalePrecision(whole.problem, stamps, *precision);
+    fmt::print("map {}: {} keyframes ({} and {} in the stretches), {} points, {} observations\n", map->id,
+               r.keyframes, r.first_keyframes, r.second_keyframes, r.points, r.observations);
+    fmt::print("residual noise {:.3f} sigma per coordinate; {} trials at {:.3f} sigma\n", r.residual_noise, r.steps.size(),
+               r.noise);
+    fmt::print("scale step: mean {:.4f}, sd {:.4f} ({:.2f}%)\n", r.mean, r.sd, 100.0 * r.sd);
   });
 }
 

@@ -10,6 +10,7 @@
 #include "core/matching/fusion.hpp"
 #include "core/matching/projection_matcher.hpp"
 #include "core/optim/bundle_adjustment.hpp"
+#include "core/optim/map_ba_problem.hpp"
 #include "core/optim/pose_graph.hpp"
 #include "core/optim/sim3_refine.hpp"
 
@@ -439,43 +440,18 @@ void LoopCloser::optimizeEssentialGraph(Map& map, const LoopCorrection& c, LoopE
 
 void LoopCloser::globalBundleAdjustment(Map& map, int iterations) {
   const auto t0 = std::chrono::steady_clock::now();
-  BaProblem ba;
-  std::vector<KeyFrame*> kfs;
-  std::vector<MapPoint*> pts;
+  MapBaProblem whole;
   uint64_t epoch = 0;
   {
     std::lock_guard lock(map.mutex);
     epoch = map.epoch;
-    std::unordered_map<KeyFrame*, int> index;
-    for (const auto& [id, k] : map.keyframes)
-      if (!k->bad) kfs.push_back(k.get());
-    std::sort(kfs.begin(), kfs.end(), [](KeyFrame* a, KeyFrame* b) { return a->id < b->id; });
     keyframes_at_global_ba_[map.id] = map.keyframes.size();
-    if (kfs.size() < 3) return;
-    ba.K = kfs.front()->frame.K;
-    for (KeyFrame* k : kfs) {
-      index[k] = static_cast<int>(ba.poses.size());
-      ba.poses.push_back({Eigen::Quaterniond(k->T_cw.linear()), k->T_cw.translation(), k == map.origin});
-    }
-    std::vector<MapPoint*> all;
-    for (const auto& [id, p] : map.points)
-      if (!p->bad && p->observations.size() >= 2) all.push_back(p.get());
-    std::sort(all.begin(), all.end(), [](MapPoint* a, MapPoint* b) { return a->id < b->id; });
-    for (MapPoint* p : all) {
-      const int point = static_cast<int>(ba.points.size());
-      int n = 0;
-      for (const auto& [k, idx] : p->observations) {
-        auto it = index.find(k);
-        if (it == index.end()) continue;
-        const auto& kp = k->frame.keypoints[static_cast<size_t>(idx)];
-        ba.observations.push_back({it->second, point, k->frame.points[static_cast<size_t>(idx)],
-                                   1.0 / scales_[static_cast<size_t>(kp.octave)]});
-        ++n;
-      }
-      ba.points.push_back({p->position, false});
-      pts.push_back(p);
-    }
+    whole = buildMapBaProblem(map, scales_);
   }
+  const std::vector<KeyFrame*>& kfs = whole.keyframes;
+  const std::vector<MapPoint*>& pts = whole.points;
+  BaProblem& ba = whole.problem;
+  if (kfs.size() < 3) return;
   PoseCorrection correction;
   for (size_t i = 0; i < kfs.size(); ++i) correction.before[kfs[i]] = Sim3(ba.poses[i].q_cw, ba.poses[i].t_cw, 1.0);
   BaOptions o;
