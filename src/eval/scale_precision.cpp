@@ -71,11 +71,12 @@ ScalePrecision computeScalePrecision(const core::BaProblem& problem, const std::
   // holds as outliers stay out.
   core::BaProblem clean = problem;
   clean.observations.clear();
-  for (const auto& ob : problem.observations)
-    if ((project(problem, ob) - ob.uv).squaredNorm() * ob.inv_sigma * ob.inv_sigma <= 5.991) {
-      clean.observations.push_back(ob);
-      clean.observations.back().uv = project(problem, ob);
-    }
+  for (const auto& ob : problem.observations) {
+    const Eigen::Vector2d exact = project(problem, ob);
+    if ((exact - ob.uv).squaredNorm() * ob.inv_sigma * ob.inv_sigma > 5.991) continue;
+    clean.observations.push_back(ob);
+    clean.observations.back().uv = exact;
+  }
   const Eigen::Matrix3Xd first_clean = centres(clean, first), second_clean = centres(clean, second);
 
   std::mt19937_64 rng(options.seed);

@@ -23,13 +23,14 @@ double stretchScale(const std::vector<Eigen::Vector3d>& est, const std::vector<E
 
 ScaleStep computeScaleStep(const io::Trajectory& ref, const io::Trajectory& est, const StretchSplit& split,
                            const MatchOptions& match) {
-  const Association a = match.by_index ? associateByIndex(ref, est) : associateByTime(ref, est, match.max_diff);
-  if (a.size() == 0) throw InputError("no poses of the estimate match the reference");
-  const double t0 = est.stamps[a.est.front()];
+  MatchOptions paired = match;
+  paired.alignment = Alignment::None;  // each stretch is aligned on its own below
+  const AlignedPair pair = matchAndAlign(ref, est, paired);
+  const double t0 = pair.est.stamps.front();
   std::vector<Eigen::Vector3d> est1, ref1, est2, ref2;
-  for (size_t i = 0; i < a.size(); ++i) {
-    const double t = est.stamps[a.est[i]] - t0;
-    const Eigen::Vector3d pe = est.poses[a.est[i]].translation(), pr = ref.poses[a.ref[i]].translation();
+  for (size_t i = 0; i < pair.est.size(); ++i) {
+    const double t = pair.est.stamps[i] - t0;
+    const Eigen::Vector3d pe = pair.est.poses[i].translation(), pr = pair.ref.poses[i].translation();
     if (t <= split.before) {
       est1.push_back(pe);
       ref1.push_back(pr);
