@@ -1,7 +1,7 @@
-// Speed of the SLAM core's per-frame work at 752x480 with 1000 features: ORB extraction,
-// the whole frame construction (extraction + undistortion + grid) and pose-only optimization
-// (called twice per tracked frame). End-to-end tracking time is `hiveslam run --realtime`'s
-// tracking_ms (docs/BENCHMARKS.md).
+// Speed of the SLAM core's per-frame work at 752x480 with 1000 features: ORB extraction (with
+// and without sub-pixel corners), the whole frame construction (extraction + undistortion +
+// grid) and pose-only optimization (called twice per tracked frame). End-to-end tracking time
+// is `hiveslam run --realtime`'s tracking_ms (docs/BENCHMARKS.md).
 #include <benchmark/benchmark.h>
 
 #include <opencv2/core/utility.hpp>
@@ -37,6 +37,18 @@ void OrbExtract(benchmark::State& state) {
   state.counters["keypoints"] = static_cast<double>(kps.size());
 }
 BENCHMARK(OrbExtract)->Arg(1000)->Arg(2000)->Unit(benchmark::kMillisecond);
+
+// The same with sub-pixel corners (orb.subpixel): the cost of the refinement is the difference.
+void OrbExtractSubPixel(benchmark::State& state) {
+  hiveslam::features::OrbOptions o;
+  o.features = static_cast<int>(state.range(0));
+  o.subpixel = true;
+  const hiveslam::features::OrbExtractor orb(o);
+  std::vector<cv::KeyPoint> kps;
+  cv::Mat desc;
+  for (auto _ : state) orb.extract(image(), kps, desc);
+}
+BENCHMARK(OrbExtractSubPixel)->Arg(1000)->Unit(benchmark::kMillisecond);
 
 void MakeFrame(benchmark::State& state) {
   const hiveslam::features::OrbExtractor orb;

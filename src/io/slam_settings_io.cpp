@@ -90,6 +90,7 @@ void applySlamSettings(const std::filesystem::path& file, core::SlamSettings& s)
       {"fast_threshold", set(s.orb.fast_threshold)},
       {"min_fast_threshold", set(s.orb.min_fast_threshold)},
       {"cell_size", set(s.orb.cell_size)},
+      {"subpixel", set(s.orb.subpixel)},
   };
   apply(file, slam, keys, "", "orb");
   if (slam["orb"]) apply(file, slam["orb"], orb_keys, "orb.");

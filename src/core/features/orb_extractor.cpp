@@ -10,6 +10,7 @@
 #include <queue>
 
 #include "core/features/brief_pattern.hpp"
+#include "core/features/corner_refinement.hpp"
 
 namespace hiveslam::features {
 
@@ -335,9 +336,20 @@ void OrbExtractor::extract(const cv::Mat& gray, std::vector<cv::KeyPoint>& keypo
     CV_Assert(n_desc + static_cast<int>(kept.size()) <= all_desc.rows);
     for (size_t i = 0; i < kept.size(); ++i) {
       cv::KeyPoint& kp = kept[i];
-      const cv::Point2f at(kp.pt.x + kBorder, kp.pt.y + kBorder);
-      kp.angle = orientation(padded, at);
-      describe(smooth, kp, at, all_desc.ptr<uchar>(n_desc++));
+      cv::Point2f at(kp.pt.x + kBorder, kp.pt.y + kBorder);
+      if (options_.subpixel) {
+        const auto corner = refineCorner(padded, cv::Point(cvRound(at.x), cvRound(at.y)));
+        // Inside the level, so the patches below stay inside the padding.
+        if (corner && corner->x >= kBorder && corner->y >= kBorder && corner->x <= kBorder + W - 1 &&
+            corner->y <= kBorder + H - 1) {
+          at = *corner;
+          kp.pt = at - cv::Point2f(kBorder, kBorder);
+        }
+      }
+      // Orientation and descriptor at the pixel nearest the corner.
+      const cv::Point2f pixel(static_cast<float>(cvRound(at.x)), static_cast<float>(cvRound(at.y)));
+      kp.angle = orientation(padded, pixel);
+      describe(smooth, kp, pixel, all_desc.ptr<uchar>(n_desc++));
       kp.octave = level;
       kp.size = static_cast<float>(31.0 * s);
       // resize maps pixel centres: level pixel x sits at (x + 0.5) sx - 0.5 on level 0, with
