@@ -18,8 +18,8 @@ struct OrbOptions {
   int cell_size = 32;           // pixels, FAST grid cell
   // Place each corner between pixels (the Harris peak, core/features/corner_refinement): on
   // rendered views a measurement 3x more precise than the FAST pixel, for about 0.3 ms a frame.
-  // Off by default: on the real KITTI excerpt it lost tracking in 5 of 24 runs (0 of 24 without)
-  // and did not lower the ATE there (docs/BENCHMARKS.md, session 19).
+  // Off by default: on the real KITTI excerpt it lost tracking in 14 of 56 runs (2 of 56
+  // without) and did not lower the ATE there (docs/BENCHMARKS.md, session 19).
   bool subpixel = false;
 };
 
