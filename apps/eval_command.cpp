@@ -167,11 +167,10 @@ void addEvalCommand(CLI::App& app) {
       ->capture_default_str()->check(CLI::Range(2, 1000));
   precision_cmd->callback([=]() {
     const auto map = pickMap(io::loadAtlas(*atlas), *map_id);
-    const features::OrbOptions orb;  // the atlas keeps keypoint levels, not the pyramid's factor
-    std::vector<double> scales{1.0};
-    for (int l = 1; l < orb.levels; ++l) scales.push_back(scales.back() * orb.scale_factor);
+    // The atlas keeps keypoint levels, not the pyramid's factor: the default pyramid's scales.
+    const features::OrbExtractor pyramid;
     std::lock_guard lock(map->mutex);
-    const core::MapBaProblem whole = core::buildMapBaProblem(*map, scales);
+    const core::MapBaProblem whole = core::buildMapBaProblem(*map, pyramid.scales());
     std::vector<double> stamps;
     for (const core::KeyFrame* k : whole.keyframes) stamps.push_back(k->frame.timestamp);
     const auto r = eval::computeScalePrecision(whole.problem, stamps, *precision);

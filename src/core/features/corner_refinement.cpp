@@ -7,10 +7,12 @@ namespace hiveslam::features {
 
 namespace {
 
-constexpr int kWindow = 3;                 // Gaussian window radius
-constexpr int kMaxGrid = kCornerClimb + 1;  // response grid radius: the climb and the fit
-constexpr int kMaxSide = 2 * kMaxGrid + 1;
-static_assert(kMaxGrid + kWindow + 1 <= kCornerReach, "the Sobel of the window's rim must be inside the reach");
+constexpr int kWindow = 3;                // Gaussian window radius
+constexpr int kGrid = kCornerClimb + 1;   // response grid radius: the climb and the fit
+constexpr int kGridSide = 2 * kGrid + 1;
+constexpr int kTensor = kGrid + kWindow;  // radius of the gradient products the window reads
+constexpr int kTensorSide = 2 * kTensor + 1;
+static_assert(kTensor + 1 <= kCornerReach, "the Sobel of the window's rim must be inside the reach");
 
 // Weights of the Gaussian window, sigma 1.8 px: wide enough that the response is smooth at the
 // pixel scale (the quadratic fit needs that), narrow enough to stay on one corner.
@@ -26,34 +28,32 @@ const std::array<float, 2 * kWindow + 1>& windowWeights() {
   return w;
 }
 
-// The Harris response on the (2 grid + 1)^2 pixels at the centre of a float patch of side
-// 2 (grid + kWindow + 1) + 1: Sobel gradients, their products, a separable Gaussian window.
+// The Harris response on the kGridSide^2 pixels around `centre`: Sobel gradients read straight
+// from the 8-bit image (no patch copied per corner: this runs for every keypoint of every
+// frame), their products, a separable Gaussian window.
 struct ResponseGrid {
-  int grid = 0;
-  double r[kMaxSide][kMaxSide];
-  double at(int dx, int dy) const { return r[dy + grid][dx + grid]; }
+  double r[kGridSide][kGridSide];
+  double at(int dx, int dy) const { return r[dy + kGrid][dx + kGrid]; }
 };
-ResponseGrid harrisResponse(const cv::Mat& patch, int grid) {
-  const int tensor = grid + kWindow, side = 2 * tensor + 1, out = 2 * grid + 1;
-  CV_Assert(patch.type() == CV_32F && patch.rows == side + 2 && patch.cols == side + 2);
-  float xx[kMaxSide + 2 * kWindow][kMaxSide + 2 * kWindow], xy[kMaxSide + 2 * kWindow][kMaxSide + 2 * kWindow],
-      yy[kMaxSide + 2 * kWindow][kMaxSide + 2 * kWindow];
-  for (int r = 0; r < side; ++r) {
-    const float* up = patch.ptr<float>(r) + 1;
-    const float* mid = patch.ptr<float>(r + 1) + 1;
-    const float* down = patch.ptr<float>(r + 2) + 1;
-    for (int c = 0; c < side; ++c) {
-      const float gx = (up[c + 1] - up[c - 1]) + 2 * (mid[c + 1] - mid[c - 1]) + (down[c + 1] - down[c - 1]);
-      const float gy = (down[c - 1] - up[c - 1]) + 2 * (down[c] - up[c]) + (down[c + 1] - up[c + 1]);
+ResponseGrid harrisResponse(const cv::Mat& img, cv::Point centre) {
+  float xx[kTensorSide][kTensorSide], xy[kTensorSide][kTensorSide], yy[kTensorSide][kTensorSide];
+  for (int r = 0; r < kTensorSide; ++r) {
+    const int y = centre.y - kTensor + r, x0 = centre.x - kTensor;
+    const uchar* up = img.ptr<uchar>(y - 1) + x0;
+    const uchar* mid = img.ptr<uchar>(y) + x0;
+    const uchar* down = img.ptr<uchar>(y + 1) + x0;
+    for (int c = 0; c < kTensorSide; ++c) {
+      const float gx = static_cast<float>((up[c + 1] - up[c - 1]) + 2 * (mid[c + 1] - mid[c - 1]) + (down[c + 1] - down[c - 1]));
+      const float gy = static_cast<float>((down[c - 1] - up[c - 1]) + 2 * (down[c] - up[c]) + (down[c + 1] - up[c + 1]));
       xx[r][c] = gx * gx;
       xy[r][c] = gx * gy;
       yy[r][c] = gy * gy;
     }
   }
   const auto& w = windowWeights();
-  float hxx[kMaxSide + 2 * kWindow][kMaxSide], hxy[kMaxSide + 2 * kWindow][kMaxSide], hyy[kMaxSide + 2 * kWindow][kMaxSide];
-  for (int r = 0; r < side; ++r)
-    for (int c = 0; c < out; ++c) {
+  float hxx[kTensorSide][kGridSide], hxy[kTensorSide][kGridSide], hyy[kTensorSide][kGridSide];
+  for (int r = 0; r < kTensorSide; ++r)
+    for (int c = 0; c < kGridSide; ++c) {
       float a = 0, b = 0, d = 0;
       for (int k = 0; k <= 2 * kWindow; ++k) {
         a += w[static_cast<size_t>(k)] * xx[r][c + k];
@@ -65,9 +65,8 @@ ResponseGrid harrisResponse(const cv::Mat& patch, int grid) {
       hyy[r][c] = d;
     }
   ResponseGrid g;
-  g.grid = grid;
-  for (int r = 0; r < out; ++r)
-    for (int c = 0; c < out; ++c) {
+  for (int r = 0; r < kGridSide; ++r)
+    for (int c = 0; c < kGridSide; ++c) {
       double a = 0, b = 0, d = 0;
       for (int k = 0; k <= 2 * kWindow; ++k) {
         a += w[static_cast<size_t>(k)] * hxx[r + k][c];
@@ -102,10 +101,7 @@ std::optional<cv::Point2f> refineCorner(const cv::Mat& img, cv::Point pixel) {
       pixel.y >= img.rows - kCornerReach)
     return std::nullopt;
   // Whole pixels first: climb the response to its local maximum near the FAST pixel.
-  const int half = kMaxGrid + kWindow + 1;
-  cv::Mat patch;
-  img(cv::Rect(pixel.x - half, pixel.y - half, 2 * half + 1, 2 * half + 1)).convertTo(patch, CV_32F);
-  const ResponseGrid coarse = harrisResponse(patch, kMaxGrid);
+  const ResponseGrid coarse = harrisResponse(img, pixel);
   int cx = 0, cy = 0;
   for (int step = 0; step <= kCornerClimb; ++step) {
     int bx = cx, by = cy;
