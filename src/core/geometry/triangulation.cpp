@@ -5,9 +5,8 @@
 
 namespace hiveslam::core {
 
-std::optional<Eigen::Vector3d> triangulate(const Eigen::Vector3d& r1, const Eigen::Vector3d& r2,
-                                           const Eigen::Isometry3d& T_21, double f,
-                                           const TriangulationCheck& check, double* parallax_cos) {
+std::optional<Eigen::Vector3d> intersectRays(const Eigen::Vector3d& r1, const Eigen::Vector3d& r2,
+                                             const Eigen::Isometry3d& T_21) {
   Eigen::Matrix<double, 3, 4> P1 = Eigen::Matrix<double, 3, 4>::Zero();
   P1.leftCols<3>().setIdentity();
   const Eigen::Matrix<double, 3, 4> P2 = T_21.matrix().topRows<3>();
@@ -20,6 +19,15 @@ std::optional<Eigen::Vector3d> triangulate(const Eigen::Vector3d& r1, const Eige
   if (std::abs(X.w()) < 1e-12) return std::nullopt;
   const Eigen::Vector3d p1 = X.head<3>() / X.w();
   if (!p1.allFinite()) return std::nullopt;
+  return p1;
+}
+
+std::optional<Eigen::Vector3d> triangulate(const Eigen::Vector3d& r1, const Eigen::Vector3d& r2,
+                                           const Eigen::Isometry3d& T_21, double f,
+                                           const TriangulationCheck& check, double* parallax_cos) {
+  const auto X = intersectRays(r1, r2, T_21);
+  if (!X) return std::nullopt;
+  const Eigen::Vector3d& p1 = *X;
   const Eigen::Vector3d p2 = T_21 * p1;
   if (p1.z() <= 0 || p2.z() <= 0) return std::nullopt;
   const Eigen::Vector3d c2_in_1 = T_21.inverse().translation();

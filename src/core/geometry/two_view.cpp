@@ -47,9 +47,24 @@ struct Candidate {
   Eigen::Isometry3d T_21;
   std::vector<Eigen::Vector3d> points;
   std::vector<bool> good;
-  int count = 0;
+  int count = 0;      // matches triangulated with parallax, in front of both views
+  int explained = 0;  // those, plus matches too close to parallel to say where they are
   double median_parallax_deg = 0;
 };
+
+// A match the motion explains without placing it: its rays meet within the reprojection
+// threshold but at too little parallax to tell the side of the cameras (or at infinity).
+bool explainedWithoutParallax(const Eigen::Vector3d& r1, const Eigen::Vector3d& r2, const Eigen::Isometry3d& T_21,
+                              double f, const TriangulationCheck& check) {
+  const auto X = intersectRays(r1, r2, T_21);
+  if (!X) return f * (T_21.linear() * r1).normalized().cross(r2.normalized()).norm() <= check.max_reprojection_px;
+  const Eigen::Vector3d p2 = T_21 * *X;
+  const Eigen::Vector3d c2_in_1 = T_21.inverse().translation();
+  const double cos_parallax = std::abs(X->normalized().dot((*X - c2_in_1).normalized()));
+  if (cos_parallax <= check.min_parallax_cos) return false;
+  return f * (X->head<2>() / X->z() - r1.head<2>()).norm() <= check.max_reprojection_px &&
+         f * (p2.head<2>() / p2.z() - r2.head<2>()).norm() <= check.max_reprojection_px;
+}
 
 Candidate reconstruct(const Eigen::Matrix3d& R, const Eigen::Vector3d& t, const std::vector<Eigen::Vector2d>& p1,
                       const std::vector<Eigen::Vector2d>& p2, const Intrinsics& K, const TwoViewOptions& o) {
@@ -63,13 +78,18 @@ Candidate reconstruct(const Eigen::Matrix3d& R, const Eigen::Vector3d& t, const 
   // Reprojection check in pixels of the sigma-scaled 2-dof threshold.
   TriangulationCheck check = o.check;
   check.max_reprojection_px = std::max(check.max_reprojection_px, 0.0);
+  const double f = 0.5 * (K.fx + K.fy);
   for (size_t i = 0; i < p1.size(); ++i) {
     double cos_parallax = 1.0;
-    const auto X = triangulate(K.ray(p1[i]), K.ray(p2[i]), c.T_21, 0.5 * (K.fx + K.fy), check, &cos_parallax);
-    if (!X) continue;
+    const auto X = triangulate(K.ray(p1[i]), K.ray(p2[i]), c.T_21, f, check, &cos_parallax);
+    if (!X) {
+      c.explained += explainedWithoutParallax(K.ray(p1[i]), K.ray(p2[i]), c.T_21, f, check);
+      continue;
+    }
     c.points[i] = *X;
     c.good[i] = true;
     ++c.count;
+    ++c.explained;
     parallax.push_back(std::acos(std::clamp(cos_parallax, -1.0, 1.0)) * 180.0 / M_PI);
   }
   if (!parallax.empty()) {
@@ -153,6 +173,16 @@ TwoViewResult initializeTwoView(const std::vector<Eigen::Vector2d>& p1, const st
     r.reason = "ambiguous motion";
     return r;
   }
+  // The motion that triangulates the most points must also explain the most matches. On a thin
+  // baseline a wrong rotation wins the count: its error shows up as parallax, so it
+  // "triangulates" nearly every match, while the true motion leaves most of them too parallel to
+  // place (KITTI 07, frames 0-1: a homography solution 1.3 degrees off placed 93% of the matches
+  // at 1.3 degrees of parallax, and two other decompositions explained more of the matches).
+  for (const Candidate& c : candidates)
+    if (c.explained > best.explained) {
+      r.reason = "parallax from a rotation error";
+      return r;
+    }
   if (best.median_parallax_deg < o.min_parallax_deg) {
     r.reason = "too little parallax";
     return r;
