@@ -97,7 +97,10 @@ void expectRecovered(const Views& v) {
   EXPECT_LT(rel[rel.size() / 2], 0.03);
 }
 
-TEST(TwoView, RecoversMotionOnTheLoop) { expectRecovered(render("loop", 100, 118, 1)); }
+// Frame 100 of the loop faces mostly one wall: against frames 112-118 and 122 its two homography
+// decompositions explain the matches equally well (within 2 of 329-437), the initializer refuses
+// them as ambiguous and waits; against 120 the motion is unique.
+TEST(TwoView, RecoversMotionOnTheLoop) { expectRecovered(render("loop", 100, 120, 1)); }
 TEST(TwoView, RecoversMotionOnTheSweep) { expectRecovered(render("sweep", 300, 316, 4)); }
 
 TEST(TwoView, RefusesPureRotation) {

@@ -70,6 +70,8 @@ class Tracker {
   bool needKeyframe(const Tracked& current, bool mapping_idle) const;
   bool keyframeWanted(const Tracked& current) const;  // the point-ratio half of the decision
   std::shared_ptr<KeyFrame> makeKeyframe(const Tracked& current);
+  // The keyframe a tracked frame's pose is kept relative to (TrackingOutput::reference).
+  std::shared_ptr<KeyFrame> nearestKeyframe(const Tracked& current) const;
 
   SlamSettings settings_;
   IdGenerator& ids_;
