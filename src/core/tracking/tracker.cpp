@@ -244,8 +244,8 @@ std::shared_ptr<KeyFrame> Tracker::nearestKeyframe(const Tracked& c) const {
   // sees the frame's points. Corrections (local and global BA, loop closing) move and rescale the
   // map around keyframes, and a relative pose follows its keyframe rigidly apart from the
   // scale: its error grows with its length. Right after initialization the first keyframe
-  // shares the most points with every frame for a second or more, and a loop closure's global
-  // BA rescaled that stretch by 1.2%: those frames came out 4 to 32 mm off (loop, 500 frames)
+  // shares the most points with every frame for a second or more; after a loop closure those
+  // frames came out 4 to 32 mm off, growing with their distance from it (loop, 500 frames),
   // while the keyframes were within 4 mm.
   const Eigen::Vector3d center = c.T_cw.inverse().translation();
   std::shared_ptr<KeyFrame> best = reference_;
