@@ -27,30 +27,24 @@ const cv::Mat& image() {
   return img;
 }
 
-// FAST pixels, no sub-pixel refinement.
-void OrbExtract(benchmark::State& state) {
+void extractFeatures(benchmark::State& state, bool subpixel) {
   hiveslam::features::OrbOptions o;
   o.features = static_cast<int>(state.range(0));
-  o.subpixel = false;
+  o.subpixel = subpixel;
   const hiveslam::features::OrbExtractor orb(o);
   std::vector<cv::KeyPoint> kps;
   cv::Mat desc;
   for (auto _ : state) orb.extract(image(), kps, desc);
   state.counters["keypoints"] = static_cast<double>(kps.size());
 }
+
+// FAST pixels, no sub-pixel refinement.
+void OrbExtract(benchmark::State& state) { extractFeatures(state, false); }
 BENCHMARK(OrbExtract)->Arg(1000)->Arg(2000)->Unit(benchmark::kMillisecond);
 
 // The same with sub-pixel corners (orb.subpixel, the default): the cost of the refinement is the
 // difference.
-void OrbExtractSubPixel(benchmark::State& state) {
-  hiveslam::features::OrbOptions o;
-  o.features = static_cast<int>(state.range(0));
-  o.subpixel = true;
-  const hiveslam::features::OrbExtractor orb(o);
-  std::vector<cv::KeyPoint> kps;
-  cv::Mat desc;
-  for (auto _ : state) orb.extract(image(), kps, desc);
-}
+void OrbExtractSubPixel(benchmark::State& state) { extractFeatures(state, true); }
 BENCHMARK(OrbExtractSubPixel)->Arg(1000)->Unit(benchmark::kMillisecond);
 
 void MakeFrame(benchmark::State& state) {
