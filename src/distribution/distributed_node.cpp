@@ -45,7 +45,7 @@ DistributedNode::DistributedNode(core::SlamSystem& slam, communication::Transpor
           slam_.submit(a.map, a.keyframe, core::SlamSystem::Module::Mapping);
         }
       },
-      [this](const Message& m) { onControl(m, Topic::TrKeyframes); });
+      [this](const Message& m) { onControl(m, Topic::TrKeyframes); }, [this](core::Id id) { awaitMap(id); });
   MapHandler::Hooks hooks;
   hooks.hold = [this](const MapRecord& m) {
     std::lock_guard lock(mutex_);
@@ -113,6 +113,7 @@ Plan DistributedNode::plan() const {
 
 void DistributedNode::onPeer(const PeerInfo& peer, bool present) {
   bool newcomer = false;
+  const Plan before = plan();
   {
     std::lock_guard lock(mutex_);
     if (present) {
@@ -126,12 +127,41 @@ void DistributedNode::onPeer(const PeerInfo& peer, bool present) {
   spdlog::info("node {}: peer {} ({}) {}", options_.id, peer.name, communication::taskName(peer.task),
                present ? (newcomer ? "joined" : "changed") : "left");
   applyPlan();
-  // A node that joins late gets the maps so far from the gateway.
-  if (newcomer && plan().local_maps)
-    for (const auto& map : slam_.liveMaps()) {
-      std::lock_guard lock(mutex_);
-      handler_->sendGlobal(map, synced_[map->id], Topic::LmMap, {}, true);
+  // A node that joins late gets the maps so far from the gateway; a mapping node that joins
+  // (or returns) gets them from the node that mapped until now, which gives mapping up to it.
+  const Plan after = plan();
+  if (newcomer && (after.local_maps || (before.mapping && !after.mapping))) sendMapsTo(peer);
+}
+
+void DistributedNode::sendMapsTo(const PeerInfo& peer) {
+  // Every task reads the map topic; keyframes go from here to an LM or an LC only.
+  Newcomer newcomer{peer.node, {Topic::LmMap}, std::chrono::milliseconds(options_.settings.handover_wait_ms)};
+  const Plan p = plan();
+  if (p.keyframes_to_lm && peer.task == Task::Mapping) newcomer.reads.push_back(Topic::TrKeyframes);
+  if (p.keyframes_to_lc && peer.task == Task::LoopClosing) newcomer.reads.push_back(Topic::LmKeyframes);
+  for (const auto& map : slam_.liveMaps()) {
+    publisher_->push({map, nullptr, Topic::TrKeyframes, 0, true});
+    std::lock_guard lock(mutex_);
+    handler_->sendGlobal(map, synced_[map->id], Topic::LmMap, {}, true, newcomer);
+  }
+}
+
+void DistributedNode::awaitMap(core::Id id) {
+  if (slam_.findMap(id)) return;
+  const auto until = std::chrono::steady_clock::now() + std::chrono::milliseconds(options_.settings.handover_wait_ms);
+  {
+    std::lock_guard lock(mutex_);
+    ++maps_awaited_;
+  }
+  spdlog::info("node {}: keyframes of map {} wait for its snapshot", options_.id, id);
+  while (!slam_.findMap(id)) {
+    std::unique_lock lock(mutex_);
+    if (stopping_ || std::chrono::steady_clock::now() >= until) {
+      spdlog::warn("node {}: no snapshot of map {} came; its keyframes are mapped without it", options_.id, id);
+      return;
     }
+    changed_.wait_for(lock, std::chrono::milliseconds(20));
+  }
 }
 
 void DistributedNode::applyPlan() {
@@ -439,6 +469,7 @@ nlohmann::json DistributedNode::report(double seconds) const {
     std::lock_guard lock(mutex_);
     j["globals_ignored"] = globals_ignored_;
     j["local_maps_held"] = local_maps_held_;
+    j["maps_awaited"] = maps_awaited_;
     j["stale_points_carried"] = integrator_.stalePointsCarried();
     j["peers"] = peers_.size();
   }

@@ -7,6 +7,10 @@
 // it has, forwards it to LC; LC finishes its queue and answers Done; LM then sends a last full
 // snapshot of its maps and Done on its map topic. A node is finished when it has that Done:
 // from then on every node's S_full holds the same keyframes and points (eventual consistency).
+//
+// Hand-over: a node that joins the network gets the maps so far as a full snapshot, from the
+// gateway (a late LC) or from the node that mapped until it came (an LM that joins or returns
+// after TR took mapping back). Its keyframes of those maps wait for the snapshot.
 #include <atomic>
 #include <chrono>
 #include <condition_variable>
@@ -68,6 +72,11 @@ class DistributedNode final : public core::SystemEvents {
   void onGlobal(std::vector<MapRecord>&& batches, communication::Topic topic);
   void onControl(const communication::Message& m, communication::Topic topic);
   void finishAsGateway();
+  // A newcomer gets this node's maps so far (see Hand-over above).
+  void sendMapsTo(const communication::PeerInfo& peer);
+  // Subscriber thread: until map `id` is held here, a new node's start-up is over, or the
+  // node stops (handover_wait_ms at most).
+  void awaitMap(core::Id id);
   bool remoteIdle() const;
   void remoteWait() const;
   communication::PeerInfo self() const;
@@ -98,6 +107,7 @@ class DistributedNode final : public core::SystemEvents {
   int globals_ignored_ = 0;
   int local_maps_held_ = 0;  // local maps that came ahead of their global update
   uint64_t incarnation_ = 0;
+  int maps_awaited_ = 0;  // keyframes that waited for a hand-over
   uint64_t knownEpoch(core::Id map) const;  // the newer of synced_ and published_; mutex_ held
   void releaseHeld(core::Id map);           // applies the held local maps the epoch has reached
   std::thread finisher_;  // the end-of-run exchange (LM, LC)

@@ -28,6 +28,10 @@ struct DistributionSettings {
   // offline run waits this long at most before going on; in any run, an acknowledgement this
   // late counts as lost (the keyframe was dropped there) and no longer holds keyframes back.
   int remote_mapping_wait_ms = 2000;
+  // A node that takes a task over (a mapping node that joins or returns) gets the maps so far
+  // from the node that held them. Up to this long, its keyframes of a map it does not hold yet
+  // wait for that map: mapped from nothing, they would start a second copy of it.
+  int handover_wait_ms = 10000;
 };
 
 }  // namespace hiveslam::distribution

@@ -42,6 +42,10 @@ void KeyframePublisher::loop() {
 }
 
 void KeyframePublisher::publish(const Job& job) {
+  if (job.handed_over) {
+    maps_started_[job.map->id] = true;
+    return;
+  }
   if (!job.keyframe) {  // a control packet, in order after the keyframes before it
     transport_.publish(job.topic, controlPacket(node_, static_cast<Control>(job.target)));
     return;

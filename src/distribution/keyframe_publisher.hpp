@@ -23,6 +23,9 @@ class KeyframePublisher {
     std::shared_ptr<core::KeyFrame> keyframe;
     communication::Topic topic = communication::Topic::TrKeyframes;
     uint8_t target = 0;  // 1 LM, 2 LC; for a control packet (no keyframe) the command
+    // No packet: the map went to a newcomer in a snapshot, so its next keyframe goes without
+    // the map's earlier keyframes as companions.
+    bool handed_over = false;
   };
   // known(point): the receivers of `topic` already have the point.
   using Known = std::function<bool(communication::Topic, core::Id)>;

@@ -7,8 +7,8 @@
 
 namespace hiveslam::distribution {
 
-KeyframeSubscriber::KeyframeSubscriber(StateIntegrator& integrator, Route route, OnControl control)
-    : integrator_(integrator), route_(std::move(route)), control_(std::move(control)) {
+KeyframeSubscriber::KeyframeSubscriber(StateIntegrator& integrator, Route route, OnControl control, AwaitMap await_map)
+    : integrator_(integrator), route_(std::move(route)), control_(std::move(control)), await_map_(std::move(await_map)) {
   thread_ = std::thread([this] {
     nameThisThread("kf-subscriber");
     loop();
@@ -31,6 +31,7 @@ void KeyframeSubscriber::loop() {
     try {
       const KeyFrameMessage k = decodeKeyframe(unpack(*m, PacketKind::Keyframe));
       ++received_;
+      if (k.companions.empty() && await_map_) await_map_(k.keyframe.map);
       auto added = integrator_.addKeyframe(k, m->epoch);
       if (added.keyframe) route_(added, m->target);
     } catch (const std::exception& e) {

@@ -1,7 +1,9 @@
 #pragma once
 // The KeyFrame Subscriber: incoming keyframes, on its own thread, first in first out. Each is
 // decoded, put into its map (StateIntegrator) and handed to the module it targets. A malformed
-// message is logged and dropped.
+// message is logged and dropped. A keyframe of a map this node does not hold, and that is not
+// a new map's (no companions), waits for the map first (AwaitMap): the node took its task over
+// and the maps so far are on their way from the node that held them.
 #include <functional>
 #include <thread>
 
@@ -15,7 +17,9 @@ class KeyframeSubscriber {
  public:
   using Route = std::function<void(const StateIntegrator::Added&, uint8_t target)>;
   using OnControl = std::function<void(const communication::Message&)>;
-  KeyframeSubscriber(StateIntegrator& integrator, Route route, OnControl control);
+  // Returns once the map is held here or waiting longer makes no sense.
+  using AwaitMap = std::function<void(Id map)>;
+  KeyframeSubscriber(StateIntegrator& integrator, Route route, OnControl control, AwaitMap await_map = {});
   ~KeyframeSubscriber();
   void push(communication::Message&& m) { queue_.push(std::move(m)); }
   void finish();
@@ -28,6 +32,7 @@ class KeyframeSubscriber {
   StateIntegrator& integrator_;
   Route route_;
   OnControl control_;
+  AwaitMap await_map_;
   BlockingQueue<communication::Message> queue_;
   std::atomic<int> received_{0}, dropped_{0};
   std::thread thread_;

@@ -131,7 +131,7 @@ void MapHandler::markDirty(const std::shared_ptr<core::Map>& map, const core::Ke
 }
 
 void MapHandler::sendGlobal(const std::shared_ptr<core::Map>& map, uint64_t epoch, Topic topic,
-                            std::vector<core::Id> merged_maps, bool full) {
+                            std::vector<core::Id> merged_maps, bool full, Newcomer newcomer) {
   {
     std::lock_guard lock(mutex_);
     // A newer global update of the map replaces one not yet (fully) sent. What that one
@@ -144,6 +144,8 @@ void MapHandler::sendGlobal(const std::shared_ptr<core::Map>& map, uint64_t epoc
     g.topic = topic;
     g.merged = std::move(merged_maps);
     g.full = full;
+    g.reader_deadline = Clock::now() + newcomer.wait;
+    g.newcomer = std::move(newcomer);
     for (auto it = globals_.begin(); it != globals_.end();)
       if (it->map == map && it->topic == topic && it != globals_.begin()) {
         carryOver(*it, g);
@@ -178,8 +180,20 @@ void MapHandler::loop() {
       globals_.pop_front();
       busy_ = true;
       lock.unlock();
+      const auto reads = [&](Topic t) { return transport_.waitForReader(t, g.newcomer.node, std::chrono::milliseconds(0)); };
+      if (g.newcomer.node && g.batches.empty() && now < g.reader_deadline &&
+          !std::all_of(g.newcomer.reads.begin(), g.newcomer.reads.end(), reads)) {
+        lock.lock();
+        globals_.push_front(std::move(g));
+        next_global = Clock::now() + std::chrono::milliseconds(10);
+        continue;
+      }
       try {
-        if (g.batches.empty()) captureGlobal(g);
+        if (g.batches.empty()) {
+          captureGlobal(g);
+          if (g.newcomer.node)
+            spdlog::info("node {}: map {} goes to node {} ({} batches)", node_, g.map->id, g.newcomer.node, g.batches.size());
+        }
         if (g.next < g.batches.size()) {
           MapRecord& b = g.batches[g.next++];
           trimForSending(b, g.topic, g.full);
@@ -324,6 +338,10 @@ void MapHandler::trimForSending(MapRecord& m, Topic topic, bool full) {
 void MapHandler::carryOver(GlobalJob& from, GlobalJob& into) {
   appendNew(from.merged, into.merged);
   into.full = into.full || from.full;  // a snapshot for a newcomer stays one
+  if (!into.newcomer.node) {
+    into.newcomer = from.newcomer;
+    into.reader_deadline = from.reader_deadline;
+  }
   // Erasures ride with the first batch; a job replaced after its capture took them from the
   // map's journal already.
   const MapRecord& once = from.batches.empty() ? from.carried : from.batches.front();
@@ -347,8 +365,9 @@ void MapHandler::captureGlobal(GlobalJob& g) {
     std::vector<const core::KeyFrame*> sorted;
     for (const auto& [id, k] : map.keyframes) sorted.push_back(k.get());
     std::sort(sorted.begin(), sorted.end(), [](auto* a, auto* b) { return a->id < b->id; });
-    // Links always go with a global map: a receiver may have skipped local maps meanwhile.
-    for (const core::KeyFrame* k : sorted) kfs.push_back(captureKeyframe(*k, map.id, false));
+    // Links always go with a global map: a receiver may have skipped local maps meanwhile. A
+    // snapshot for a newcomer also carries every keyframe's features: it has none of them.
+    for (const core::KeyFrame* k : sorted) kfs.push_back(captureKeyframe(*k, map.id, g.newcomer.node != 0));
     for (const auto& [id, p] : map.points)
       if (!p->bad) points.push_back(capturePoint(*p, true));
     base.erased_keyframes = std::move(g.carried.erased_keyframes);

@@ -8,6 +8,7 @@
 // Outgoing global maps: after a loop closure, merge or global BA, the whole map in batches; a
 // newer global update of the same map restarts the sending.
 // Incoming maps: local ones are applied as they come; global ones once all their batches are in.
+#include <chrono>
 #include <condition_variable>
 #include <deque>
 #include <functional>
@@ -22,6 +23,13 @@
 #include "distribution/state_integrator.hpp"
 
 namespace hiveslam::distribution {
+
+// A node a snapshot is for (MapHandler::sendGlobal), and the topics it reads from this node.
+struct Newcomer {
+  uint16_t node = 0;
+  std::vector<communication::Topic> reads;
+  std::chrono::milliseconds wait{0};
+};
 
 class MapHandler {
  public:
@@ -48,9 +56,12 @@ class MapHandler {
                  int window = -1, bool acknowledge = false);
   // The whole map, as a global map of `epoch`, on `topic`.
   // `full`: every point with its full record and every keyframe with its links (a snapshot for
-  // a node that may have missed updates: a newcomer, or the end of a run).
+  // a node that may have missed updates: a newcomer, or the end of a run). With a newcomer
+  // the keyframes go with their features (it holds none of them), and the map is taken only
+  // once the newcomer reads every topic it gets from this node (up to `wait`): what goes
+  // before never reaches it, and what goes after the capture is not in the snapshot.
   void sendGlobal(const std::shared_ptr<core::Map>& map, uint64_t epoch, communication::Topic topic,
-                  std::vector<core::Id> merged_maps, bool full = false);
+                  std::vector<core::Id> merged_maps, bool full = false, Newcomer newcomer = {});
   // Sends everything pending (dirty keyframes, global maps), then stops the thread.
   void finish();
   // Whether nothing is waiting to be sent or applied.
@@ -75,6 +86,8 @@ class MapHandler {
     communication::Topic topic{};
     std::vector<core::Id> merged;
     bool full = false;
+    Newcomer newcomer;
+    std::chrono::steady_clock::time_point reader_deadline;
     std::vector<MapRecord> batches;  // captured when its turn comes
     size_t next = 0;
     MapRecord carried;  // erasures of the updates this one replaced

@@ -23,12 +23,14 @@ Plan decide(Task own, uint8_t present) {
       }
       break;
     case Task::Mapping:
-      // The gateway: keyframes from TR in, local maps out, LC offloaded when there is one.
+      // The gateway: keyframes from TR in, local maps out, LC offloaded when there is one. It
+      // also reads the map topic it publishes: TR, when it mapped before this node came, hands
+      // the maps so far over on it (the node's own packets are not delivered to it).
       p.mapping = true;
       p.loop_closing = !lc;
       p.keyframes_to_lc = lc;
       p.local_maps = true;
-      p.subscriptions = {Topic::TrKeyframes};
+      p.subscriptions = {Topic::TrKeyframes, Topic::LmMap};
       if (lc) p.subscriptions.push_back(Topic::LcMap);
       break;
     case Task::LoopClosing:

@@ -1,5 +1,7 @@
 #include "distribution/state_integrator.hpp"
 
+#include <spdlog/spdlog.h>
+
 #include <algorithm>
 #include <cstring>
 #include <set>
@@ -341,7 +343,14 @@ void StateIntegrator::applyGlobal(const std::vector<MapRecord>& batches, bool au
   if (authoritative)
     for (const auto& b : batches) observer_.revive(b);
   for (const auto& b : batches) observer_.record(b);
-  auto map = slam_.findMap(batches.front().map);
+  // Keyframes sent with their features (a snapshot for a node that joined) that this node
+  // does not hold yet are made here; features and bags of words before the lock. Such a
+  // snapshot may bring a map this node has never seen.
+  std::vector<std::pair<std::shared_ptr<core::KeyFrame>, const KeyFrameRecord*>> fresh;
+  for (const auto& b : batches)
+    for (const auto& k : b.keyframes)
+      if (k.full) fresh.emplace_back(makeKeyframe(k), &k);
+  auto map = fresh.empty() ? slam_.findMap(batches.front().map) : mapFor(batches.front().map);
   if (!map || map->merged_into.load()) return;
   // Maps merged into this one move over first, as they are (the records below re-pose them).
   for (const auto& b : batches)
@@ -370,6 +379,19 @@ void StateIntegrator::applyGlobal(const std::vector<MapRecord>& batches, bool au
     }
   }
   core::applyCorrection(*map, c, slam_.scales());
+  std::erase_if(fresh, [&](const auto& f) { return map->keyframes.count(f.first->id) > 0; });
+  if (!fresh.empty()) spdlog::info("map {}: {} keyframes from a snapshot", map->id, fresh.size());
+  for (const auto& [kf, r] : fresh) {
+    kf->made_in_epoch = map->epoch;  // mapped already: no queue here to wait through a correction
+    map->add(kf);
+    slam_.database().add(kf.get(), map.get());
+    if (!map->origin && kf->id == batches.front().origin) map->origin = kf.get();
+  }
+  for (const auto& [kf, r] : fresh)
+    if (auto it = map->keyframes.find(r->made_from); r->made_from != kNoId && it != map->keyframes.end()) {
+      kf->made_from = it->second.get();
+      kf->made_pose.scale = kf->made_from->scale();
+    }
   for (const auto& b : batches)
     for (const auto& p : b.points) applyPoint(*map, p, authoritative);
   for (const auto& b : batches)

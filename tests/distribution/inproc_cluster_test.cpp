@@ -70,12 +70,18 @@ StateDigest slamState(const core::SlamSystem& slam) {
 // run, checks TR's accuracy, then that every node's S_full and SLAM maps agree.
 struct ClusterRun {
   int tracked = 0, frames = 0;
+  int mapped_by_tr = 0, mapped_by_new_lm = 0;  // keyframes local mapping processed there
   double ate_fraction = 1.0;  // ATE RMSE over the path length
   int loops = 0, merges = 0;
   size_t maps_tr = 0, maps_lm = 0, maps_lc = 0;
 };
 
-ClusterRun runThreeNodes(const std::string& trajectory, int frames) {
+// Frames at which the mapping node leaves, and at which a fresh one (new id, empty maps) joins.
+struct Outage {
+  int leaves = -1, returns = -1;
+};
+
+ClusterRun runThreeNodes(const std::string& trajectory, int frames, Outage outage = {}) {
   synth::SequenceOptions o;
   o.trajectory = trajectory;
   o.frames = frames;
@@ -89,9 +95,11 @@ ClusterRun runThreeNodes(const std::string& trajectory, int frames) {
   core::SlamSystem tr(core::SlamSettings{}, camera, Mode::Offline, voc, 1);
   core::SlamSystem lm(core::SlamSettings{}, camera, Mode::Offline, voc, 2);
   core::SlamSystem lc(core::SlamSettings{}, camera, Mode::Offline, voc, 3);
+  core::SlamSystem lm2(core::SlamSettings{}, camera, Mode::Offline, voc, 4);
   communication::InProcNetwork network;
-  auto e_tr = network.endpoint(), e_lm = network.endpoint(), e_lc = network.endpoint();
+  auto e_tr = network.endpoint(), e_lm = network.endpoint(), e_lc = network.endpoint(), e_lm2 = network.endpoint();
   DistributedNode n_lm(lm, *e_lm, {Task::Mapping, 2, "lm", {}});
+  DistributedNode n_lm2(lm2, *e_lm2, {Task::Mapping, 4, "lm2", {}});
   DistributedNode n_lc(lc, *e_lc, {Task::LoopClosing, 3, "lc", {}});
   DistributedNode n_tr(tr, *e_tr, {Task::Tracking, 1, "tr", {}});
   n_lm.start();
@@ -105,11 +113,16 @@ ClusterRun runThreeNodes(const std::string& trajectory, int frames) {
   run.frames = o.frames;
   io::Trajectory truth;
   for (int f = 0; f < o.frames; ++f) {
+    if (f == outage.leaves) n_lm.stop();
+    if (f == outage.returns) n_lm2.start();
     tr.process(model.renderImage(f, rays), model.stamp(f));
     truth.add(model.stamp(f), model.pose(f));
   }
+  const bool returned = outage.returns >= 0;
+  DistributedNode& n_mapper = returned ? n_lm2 : n_lm;
+  core::SlamSystem& mapper = returned ? lm2 : lm;
   EXPECT_TRUE(n_tr.finishRun(std::chrono::seconds(120)));
-  EXPECT_TRUE(n_lm.waitUntilDone(std::chrono::seconds(30)));
+  EXPECT_TRUE(n_mapper.waitUntilDone(std::chrono::seconds(30)));
   EXPECT_TRUE(n_lc.waitUntilDone(std::chrono::seconds(30)));
 
   io::Trajectory estimate;
@@ -124,19 +137,22 @@ ClusterRun runThreeNodes(const std::string& trajectory, int frames) {
   run.loops = lc.loopStats().loops;
   run.merges = lc.loopStats().merges;
   run.maps_tr = tr.liveMaps().size();
-  run.maps_lm = lm.liveMaps().size();
+  run.maps_lm = mapper.liveMaps().size();
   run.maps_lc = lc.liveMaps().size();
-  EXPECT_EQ(tr.mappingStats().keyframes_processed, 0);  // TR mapped nothing itself
+  run.mapped_by_tr = tr.mappingStats().keyframes_processed;
+  run.mapped_by_new_lm = lm2.mappingStats().keyframes_processed;
 
-  expectSameState(n_lm.observer().digest(), n_tr.observer().digest(), "S_full LM vs TR");
-  expectSameState(n_lm.observer().digest(), n_lc.observer().digest(), "S_full LM vs LC");
-  expectSameState(slamState(lm), slamState(tr), "S_slam LM vs TR");
-  expectSameState(slamState(lm), slamState(lc), "S_slam LM vs LC");
+  expectSameState(n_mapper.observer().digest(), n_tr.observer().digest(), "S_full LM vs TR");
+  expectSameState(n_mapper.observer().digest(), n_lc.observer().digest(), "S_full LM vs LC");
+  expectSameState(slamState(mapper), slamState(tr), "S_slam LM vs TR");
+  expectSameState(slamState(mapper), slamState(lc), "S_slam LM vs LC");
   n_tr.stop();
   n_lm.stop();
+  n_lm2.stop();
   n_lc.stop();
   tr.finish();
   lm.finish();
+  lm2.finish();
   lc.finish();
   return run;
 }
@@ -146,6 +162,22 @@ TEST(InProcCluster, ThreeNodesTrackCloseTheLoopAndAgree) {
   EXPECT_GT(run.tracked, run.frames * 9 / 10);
   EXPECT_LT(run.ate_fraction, 0.01);
   EXPECT_GE(run.loops, 1);
+  EXPECT_EQ(run.mapped_by_tr, 0);  // TR mapped nothing itself
+}
+
+// The mapping node leaves a third of the way round; TR maps alone (LC stays). A fresh mapping
+// node joins at two thirds: TR hands it the map so far and mapping back. It must take over
+// the whole map, not start a second copy from the keyframes that come after it joined, and
+// the loop is still closed with every node holding the same map at the end (it once ended
+// with the new node holding only what it mapped itself, and 4 nodes' worth of disagreement).
+TEST(InProcCluster, AMappingNodeThatJoinsMidRunTakesTheWholeMapOver) {
+  const ClusterRun run = runThreeNodes("loop", 500, {160, 330});
+  EXPECT_GT(run.tracked, run.frames * 9 / 10);
+  EXPECT_LT(run.ate_fraction, 0.01);
+  EXPECT_GT(run.mapped_by_tr, 0);      // during the outage
+  EXPECT_GT(run.mapped_by_new_lm, 0);  // after it joined
+  EXPECT_GE(run.loops, 1);
+  EXPECT_EQ(run.maps_lm, 1u);
 }
 
 // After the blank stretch TR starts a second map; LC merges it into the first when TR sees

@@ -137,6 +137,43 @@ TEST(NodeProcesses, TrackingTakesMappingBackWhenTheMappingNodeDies) {
   EXPECT_GT(tr["mapping"]["keyframes_processed"].get<int>(), 0);  // it mapped after the LM left
 }
 
+// The mapping node dies at 20% of the frames and a fresh one (new id, nothing held) starts at
+// 50%: TR notices the death after the 2 s lease, maps alone, then hands the newcomer the map
+// it kept over DDS once the newcomer's readers have matched, and gives mapping up to it. At
+// the end all three hold the same map. (A newcomer that starts after TR has gone waits for
+// keyframes for good: it gets a minute after TR's end, then it is stopped.)
+TEST(NodeProcesses, AFreshMappingNodeTakesTheMapOverFromTracking) {
+  testing::TempDir out;
+  const std::string bin = HIVESLAM_BINARY, domain = " --domain " + std::to_string(200 + getpid() % 30);
+  const std::string tr_log = (out / "tr.log").string();
+  auto reached = [&](int frame) {
+    return "while kill -0 $tr && ! grep -q \"tracking " + std::to_string(frame) + "/240\" " + tr_log + "; do sleep 0.05; done; ";
+  };
+  const std::string run =
+      bin + " node --task lm" + domain + " --out " + (out / "lm").string() + " > " + (out / "lm.log").string() +
+      " 2>&1 & lm=$!; " + bin + " node --task lc" + domain + " --out " + (out / "lc").string() + " > " +
+      (out / "lc.log").string() + " 2>&1 & lc=$!; " + bin + " node --task tr " + sequence().string() + domain +
+      " --expect lm,lc --realtime --out " + (out / "tr").string() + " > " + tr_log + " 2>&1 & tr=$!; " + reached(48) +
+      "kill -9 $lm; " + reached(120) + bin + " node --task lm --id 4" + domain + " --out " + (out / "lm2").string() +
+      " > " + (out / "lm2.log").string() + " 2>&1 & lm2=$!; wait $tr; status=$?; " +
+      "for i in $(seq 600); do kill -0 $lm2 2>/dev/null || break; sleep 0.1; done; kill $lm2 $lc 2>/dev/null; wait; exit $status";
+  const int status = std::system(("timeout 300 bash -c '" + run + "'").c_str());
+  ASSERT_EQ(status, 0) << std::ifstream(tr_log).rdbuf();
+  const auto tr = report(out / "tr" / "report.json"), lm2 = report(out / "lm2" / "report.json"),
+             lc = report(out / "lc" / "report.json");
+  EXPECT_EQ(tasks(tr), std::vector<std::string>{"tr"}) << tr.dump();
+  EXPECT_EQ(lm2.value("end_of_run", ""), "completed") << std::ifstream(out / "lm2.log").rdbuf();
+  EXPECT_GT(tr["mapping"]["keyframes_processed"].get<int>(), 0);   // TR mapped during the outage
+  EXPECT_GT(lm2["mapping"]["keyframes_processed"].get<int>(), 0);  // and the newcomer after it
+  // The newcomer holds the whole map, not only what it mapped itself.
+  EXPECT_EQ(lm2.value("keyframes", -1), tr.value("keyframes", -2));
+  EXPECT_EQ(lm2.value("map_points", -1), tr.value("map_points", -2));
+  EXPECT_EQ(lc.value("map_points", -1), tr.value("map_points", -2));
+  EXPECT_EQ(tr.value("s_full_keyframes", 0), lm2.value("s_full_keyframes", -1));
+  EXPECT_EQ(lc.value("s_full_keyframes", 0), lm2.value("s_full_keyframes", -1));
+  EXPECT_LT(tr["ate"]["percent_of_path"].get<double>(), 1.0);
+}
+
 TEST(NodeProcesses, ThreeNodesInThreeNetworkNamespaces) {
   if (geteuid() != 0) GTEST_SKIP() << "network namespaces need root";
   const std::string tag = std::to_string(getpid() % 100000);

@@ -4,6 +4,7 @@
 #include <fastdds/dds/domain/DomainParticipantFactory.hpp>
 #include <fastdds/dds/domain/DomainParticipantListener.hpp>
 #include <fastdds/dds/publisher/DataWriter.hpp>
+#include <fastdds/dds/publisher/DataWriterListener.hpp>
 #include <fastdds/dds/publisher/Publisher.hpp>
 #include <fastdds/dds/publisher/qos/DataWriterQos.hpp>
 #include <fastdds/dds/subscriber/DataReader.hpp>
@@ -13,10 +14,13 @@
 #include <fastdds/dds/subscriber/qos/DataReaderQos.hpp>
 #include <fastdds/dds/topic/Topic.hpp>
 #include <fastdds/dds/topic/TypeSupport.hpp>
+#include <fastdds/rtps/common/InstanceHandle.h>
 
 #include <array>
+#include <atomic>
 #include <chrono>
 #include <condition_variable>
+#include <map>
 #include <mutex>
 #include <thread>
 #include <unordered_map>
@@ -100,6 +104,28 @@ struct DdsTransport::Impl : public dds::DomainParticipantListener {
   BlockingQueue<std::pair<PeerInfo, bool>> peer_events;
   std::thread peer_thread;
   std::condition_variable wake;
+  std::atomic<uint16_t> self_node{0};  // set before any reader exists
+
+  // The participants whose readers each writer has matched, for waitForReader. Own lock: the
+  // listener runs on Fast DDS threads, also inside create_datawriter.
+  struct WriterListener : public dds::DataWriterListener {
+    Impl* impl = nullptr;
+    size_t topic = 0;
+    void on_publication_matched(dds::DataWriter*, const dds::PublicationMatchedStatus& info) override {
+      const GuidPrefix_t prefix = eprosima::fastrtps::rtps::iHandle2GUID(info.last_subscription_handle).guidPrefix;
+      {
+        std::lock_guard lock(impl->match_mutex);
+        int& readers = impl->matched[topic][prefix];
+        readers += info.current_count_change;
+        if (readers <= 0) impl->matched[topic].erase(prefix);
+      }
+      impl->matched_changed.notify_all();
+    }
+  };
+  std::array<WriterListener, kTopicCount> writer_listeners;
+  std::mutex match_mutex;
+  std::condition_variable matched_changed;
+  std::array<std::map<GuidPrefix_t, int>, kTopicCount> matched;
 
   // Delivers a topic's packets to its handler as they arrive (on a Fast DDS thread).
   struct Reader : public dds::DataReaderListener {
@@ -111,7 +137,9 @@ struct DdsTransport::Impl : public dds::DomainParticipantListener {
       hiveslam_msgs::msg::Packet p;
       dds::SampleInfo info;
       while (r->take_next_sample(&p, &info) == ReturnCode_t::RETCODE_OK) {
-        if (!info.valid_data) continue;
+        // A reader also matches its own participant's writer of the topic (the gateway reads
+        // the map topic it publishes, for a hand-over): its own packets are not news to it.
+        if (!info.valid_data || p.source() == impl->self_node.load()) continue;
         Message m;
         m.version = p.version();
         m.source = p.source();
@@ -185,7 +213,10 @@ struct DdsTransport::Impl : public dds::DomainParticipantListener {
     q.history().depth = options.history_depth;
     q.durability().kind = dds::VOLATILE_DURABILITY_QOS;
     q.publish_mode().kind = dds::ASYNCHRONOUS_PUBLISH_MODE;  // large packets are sent off-thread
-    w = publisher->create_datawriter(topics[static_cast<size_t>(t)], q);
+    auto& listener = writer_listeners[static_cast<size_t>(t)];
+    listener.impl = this;
+    listener.topic = static_cast<size_t>(t);
+    w = publisher->create_datawriter(topics[static_cast<size_t>(t)], q, &listener);
     if (!w) throw InputError(std::string("DDS: cannot create a writer for ") + topicName(t));
     return w;
   }
@@ -243,6 +274,7 @@ void DdsTransport::start(const PeerInfo& self, PeerHandler on_peer) {
     std::lock_guard lock(d.entities);
     d.closed = false;
   }
+  d.self_node = self.node;
   {
     std::lock_guard lock(d.mutex);
     d.self = self;
@@ -327,6 +359,25 @@ void DdsTransport::unsubscribe(Topic topic) {
   }
   // Deleting the reader waits for a listener call in progress to return.
   if (r && r->reader) d.subscriber->delete_datareader(r->reader);
+}
+
+bool DdsTransport::waitForReader(Topic topic, uint16_t node, std::chrono::milliseconds timeout) {
+  Impl& d = *impl_;
+  GuidPrefix_t prefix;
+  {
+    std::lock_guard lock(d.mutex);
+    auto it = d.peers.find(node);
+    if (it == d.peers.end()) return false;
+    prefix = it->second.first;
+  }
+  {
+    std::lock_guard lock(d.entities);
+    if (d.closed) return false;
+    d.writerFor(topic);  // matching starts when the writer exists
+  }
+  std::unique_lock lock(d.match_mutex);
+  const auto& readers = d.matched[static_cast<size_t>(topic)];
+  return d.matched_changed.wait_for(lock, timeout, [&] { return readers.count(prefix) > 0; });
 }
 
 void DdsTransport::stop() {

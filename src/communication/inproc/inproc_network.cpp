@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <array>
+#include <thread>
 
 namespace hiveslam::communication {
 
@@ -85,6 +86,15 @@ void InProcNetwork::deliver(const Member* from, Topic topic, const Message& mess
   }
 }
 
+bool InProcNetwork::reads(uint16_t node, Topic topic) {
+  std::lock_guard lock(mutex_);
+  for (const auto& m : members_) {
+    std::lock_guard l(m->mutex);
+    if (m->self.node == node && m->handlers[static_cast<size_t>(topic)]) return true;
+  }
+  return false;
+}
+
 InProcTransport::InProcTransport(InProcNetwork& network)
     : network_(network), member_(std::make_shared<InProcNetwork::Member>()) {}
 
@@ -124,6 +134,16 @@ void InProcTransport::subscribe(Topic topic, Handler handler) {
 void InProcTransport::unsubscribe(Topic topic) {
   std::lock_guard lock(member_->mutex);
   member_->handlers[static_cast<size_t>(topic)].reset();
+}
+
+bool InProcTransport::waitForReader(Topic topic, uint16_t node, std::chrono::milliseconds timeout) {
+  // A peer subscribes from its own thread after joining; DDS matching has the same gap.
+  const auto until = std::chrono::steady_clock::now() + timeout;
+  while (!network_.reads(node, topic)) {
+    if (std::chrono::steady_clock::now() >= until) return false;
+    std::this_thread::sleep_for(std::chrono::milliseconds(2));
+  }
+  return true;
 }
 
 void InProcTransport::stop() {

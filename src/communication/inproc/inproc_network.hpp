@@ -24,6 +24,7 @@ class InProcNetwork {
   void leave(const std::shared_ptr<Member>& m);
   void announce(const std::shared_ptr<Member>& m);
   void deliver(const Member* from, Topic topic, const Message& message);
+  bool reads(uint16_t node, Topic topic);
   std::mutex mutex_;
   std::vector<std::shared_ptr<Member>> members_;
 };
@@ -37,6 +38,7 @@ class InProcTransport final : public Transport {
   void publish(Topic topic, Message&& message) override;
   void subscribe(Topic topic, Handler handler) override;
   void unsubscribe(Topic topic) override;
+  bool waitForReader(Topic topic, uint16_t node, std::chrono::milliseconds timeout) override;
   void stop() override;
   TrafficReport traffic() const override;
 
