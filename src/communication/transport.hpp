@@ -7,7 +7,6 @@
 //
 // Threads: publish() returns at once (never waits on a slow or dead peer). Handlers run on the
 // transport's threads and must only queue the message. Peer events come on a transport thread.
-#include <chrono>
 #include <cstdint>
 #include <functional>
 #include <map>
@@ -33,10 +32,10 @@ class Transport {
   // Only subscribed topics reach this node (and count against its bandwidth).
   virtual void subscribe(Topic topic, Handler handler) = 0;
   virtual void unsubscribe(Topic topic) = 0;
-  // Whether peer `node` reads `topic` from this node, waiting up to `timeout` for it to: what
-  // is published before a new peer's reader has matched never reaches that peer. Called off
-  // the tracking thread (it waits); false when the peer is unknown or never matched.
-  virtual bool waitForReader(Topic topic, uint16_t node, std::chrono::milliseconds timeout) = 0;
+  // Whether peer `node` reads `topic` from this node now (its reader has matched): what is
+  // published before a new peer's reader has matched never reaches that peer. False when the
+  // peer is unknown. Does not wait; the caller polls.
+  virtual bool peerReads(Topic topic, uint16_t node) = 0;
   // Announces leaving and stops delivering; idempotent.
   virtual void stop() = 0;
   virtual TrafficReport traffic() const = 0;

@@ -180,7 +180,7 @@ void MapHandler::loop() {
       globals_.pop_front();
       busy_ = true;
       lock.unlock();
-      const auto reads = [&](Topic t) { return transport_.waitForReader(t, g.newcomer.node, std::chrono::milliseconds(0)); };
+      const auto reads = [&](Topic t) { return transport_.peerReads(t, g.newcomer.node); };
       if (g.newcomer.node && g.batches.empty() && now < g.reader_deadline &&
           !std::all_of(g.newcomer.reads.begin(), g.newcomer.reads.end(), reads)) {
         lock.lock();

@@ -344,14 +344,23 @@ void StateIntegrator::applyGlobal(const std::vector<MapRecord>& batches, bool au
     for (const auto& b : batches) observer_.revive(b);
   for (const auto& b : batches) observer_.record(b);
   // Keyframes sent with their features (a snapshot for a node that joined) that this node
-  // does not hold yet are made here; features and bags of words before the lock. Such a
-  // snapshot may bring a map this node has never seen.
-  std::vector<std::pair<std::shared_ptr<core::KeyFrame>, const KeyFrameRecord*>> fresh;
+  // does not hold yet are made here; bags of words before the lock. Such a snapshot may bring
+  // a map this node has never seen. Every node reading the map topic gets the newcomer's
+  // snapshot, and holds nearly all of it: only the missing keyframes are made.
+  std::vector<const KeyFrameRecord*> with_features;
   for (const auto& b : batches)
     for (const auto& k : b.keyframes)
-      if (k.full) fresh.emplace_back(makeKeyframe(k), &k);
-  auto map = fresh.empty() ? slam_.findMap(batches.front().map) : mapFor(batches.front().map);
+      if (k.full) with_features.push_back(&k);
+  auto map = with_features.empty() ? slam_.findMap(batches.front().map) : mapFor(batches.front().map);
   if (!map || map->merged_into.load()) return;
+  std::vector<std::pair<std::shared_ptr<core::KeyFrame>, const KeyFrameRecord*>> fresh;
+  if (!with_features.empty()) {
+    {
+      std::lock_guard lock(map->mutex);
+      std::erase_if(with_features, [&](const KeyFrameRecord* k) { return map->keyframes.count(k->id) > 0; });
+    }
+    for (const KeyFrameRecord* k : with_features) fresh.emplace_back(makeKeyframe(*k), k);
+  }
   // Maps merged into this one move over first, as they are (the records below re-pose them).
   for (const auto& b : batches)
     for (Id merged : b.merged_maps) {

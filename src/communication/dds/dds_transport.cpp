@@ -106,25 +106,21 @@ struct DdsTransport::Impl : public dds::DomainParticipantListener {
   std::condition_variable wake;
   std::atomic<uint16_t> self_node{0};  // set before any reader exists
 
-  // The participants whose readers each writer has matched, for waitForReader. Own lock: the
+  // The participants whose readers each writer has matched, for peerReads. Own lock: the
   // listener runs on Fast DDS threads, also inside create_datawriter.
   struct WriterListener : public dds::DataWriterListener {
     Impl* impl = nullptr;
     size_t topic = 0;
     void on_publication_matched(dds::DataWriter*, const dds::PublicationMatchedStatus& info) override {
       const GuidPrefix_t prefix = eprosima::fastrtps::rtps::iHandle2GUID(info.last_subscription_handle).guidPrefix;
-      {
-        std::lock_guard lock(impl->match_mutex);
-        int& readers = impl->matched[topic][prefix];
-        readers += info.current_count_change;
-        if (readers <= 0) impl->matched[topic].erase(prefix);
-      }
-      impl->matched_changed.notify_all();
+      std::lock_guard lock(impl->match_mutex);
+      int& readers = impl->matched[topic][prefix];
+      readers += info.current_count_change;
+      if (readers <= 0) impl->matched[topic].erase(prefix);
     }
   };
   std::array<WriterListener, kTopicCount> writer_listeners;
   std::mutex match_mutex;
-  std::condition_variable matched_changed;
   std::array<std::map<GuidPrefix_t, int>, kTopicCount> matched;
 
   // Delivers a topic's packets to its handler as they arrive (on a Fast DDS thread).
@@ -361,7 +357,7 @@ void DdsTransport::unsubscribe(Topic topic) {
   if (r && r->reader) d.subscriber->delete_datareader(r->reader);
 }
 
-bool DdsTransport::waitForReader(Topic topic, uint16_t node, std::chrono::milliseconds timeout) {
+bool DdsTransport::peerReads(Topic topic, uint16_t node) {
   Impl& d = *impl_;
   GuidPrefix_t prefix;
   {
@@ -375,9 +371,8 @@ bool DdsTransport::waitForReader(Topic topic, uint16_t node, std::chrono::millis
     if (d.closed) return false;
     d.writerFor(topic);  // matching starts when the writer exists
   }
-  std::unique_lock lock(d.match_mutex);
-  const auto& readers = d.matched[static_cast<size_t>(topic)];
-  return d.matched_changed.wait_for(lock, timeout, [&] { return readers.count(prefix) > 0; });
+  std::lock_guard lock(d.match_mutex);
+  return d.matched[static_cast<size_t>(topic)].count(prefix) > 0;
 }
 
 void DdsTransport::stop() {

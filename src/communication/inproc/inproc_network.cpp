@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <array>
-#include <thread>
 
 namespace hiveslam::communication {
 
@@ -136,15 +135,8 @@ void InProcTransport::unsubscribe(Topic topic) {
   member_->handlers[static_cast<size_t>(topic)].reset();
 }
 
-bool InProcTransport::waitForReader(Topic topic, uint16_t node, std::chrono::milliseconds timeout) {
-  // A peer subscribes from its own thread after joining; DDS matching has the same gap.
-  const auto until = std::chrono::steady_clock::now() + timeout;
-  while (!network_.reads(node, topic)) {
-    if (std::chrono::steady_clock::now() >= until) return false;
-    std::this_thread::sleep_for(std::chrono::milliseconds(2));
-  }
-  return true;
-}
+// A peer subscribes from its own thread after joining; DDS matching has the same gap.
+bool InProcTransport::peerReads(Topic topic, uint16_t node) { return network_.reads(node, topic); }
 
 void InProcTransport::stop() {
   network_.leave(member_);

@@ -38,7 +38,7 @@ class InProcTransport final : public Transport {
   void publish(Topic topic, Message&& message) override;
   void subscribe(Topic topic, Handler handler) override;
   void unsubscribe(Topic topic) override;
-  bool waitForReader(Topic topic, uint16_t node, std::chrono::milliseconds timeout) override;
+  bool peerReads(Topic topic, uint16_t node) override;
   void stop() override;
   TrafficReport traffic() const override;
 
