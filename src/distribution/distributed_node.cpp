@@ -21,6 +21,15 @@ constexpr uint8_t kTargetLm = 1, kTargetLc = 2;
 
 bool isKeyframeTopic(Topic t) { return t == Topic::TrKeyframes || t == Topic::LmKeyframes; }
 
+// Where this incarnation's id counter starts (core/map/ids.hpp): its start time in 10 us ticks
+// since 2024-01-01 UTC.
+uint64_t firstIdCounter(std::chrono::system_clock::time_point start) {
+  using namespace std::chrono;
+  constexpr auto k2024 = sys_days{year{2024} / January / 1};
+  const auto ticks = duration_cast<microseconds>(start - k2024).count() / 10;
+  return ticks > 0 ? static_cast<uint64_t>(ticks) : 0;
+}
+
 }  // namespace
 
 DistributedNode::DistributedNode(core::SlamSystem& slam, communication::Transport& transport, NodeOptions options)
@@ -48,13 +57,16 @@ DistributedNode::DistributedNode(core::SlamSystem& slam, communication::Transpor
       [this](const Message& m) { onControl(m, Topic::TrKeyframes); }, [this](core::Id id) { awaitMap(id); });
   MapHandler::Hooks hooks;
   hooks.hold = [this](const MapRecord& m) {
-    std::lock_guard lock(mutex_);
-    if (m.epoch <= knownEpoch(m.map)) return false;
-    // Bounded: a global update that never comes (its sender died) costs old poses, not memory.
-    constexpr size_t kMaxHeld = 256;
-    if (held_.size() >= kMaxHeld) held_.erase(held_.begin());
-    held_.push_back(m);
-    ++local_maps_held_;
+    {
+      std::lock_guard lock(mutex_);
+      if (m.epoch <= knownEpoch(m.map)) return false;
+      // Bounded: a global update that never comes (its sender died) costs old poses, not memory.
+      constexpr size_t kMaxHeld = 256;
+      if (held_.size() >= kMaxHeld) held_.erase(held_.begin());
+      held_.push_back(m);
+      ++local_maps_held_;
+    }
+    integrator_.applyAhead(m);  // its new points, until the whole record can go in
     return true;
   };
   hooks.global = [this](std::vector<MapRecord>&& b, Topic t) { onGlobal(std::move(b), t); };
@@ -89,7 +101,9 @@ PeerInfo DistributedNode::self() const {
 }
 
 void DistributedNode::start() {
-  incarnation_ = static_cast<uint64_t>(std::chrono::system_clock::now().time_since_epoch().count());
+  const auto now = std::chrono::system_clock::now();
+  incarnation_ = static_cast<uint64_t>(now.time_since_epoch().count());
+  slam_.startIdsAt(firstIdCounter(now));
   {
     std::lock_guard lock(mutex_);
     plan_ = decide(options_.task, 0);

@@ -99,9 +99,10 @@ void Observer::erasePoint(Id id) {
   erased_points_.insert(id);
 }
 
-std::optional<std::vector<MapRecord>> Observer::collectGlobal(MapRecord&& batch) {
+std::optional<std::vector<MapRecord>> Observer::collectGlobal(MapRecord&& batch, uint16_t sender) {
   std::lock_guard lock(mutex_);
-  auto& pending = pending_global_[batch.map];
+  const std::pair<Id, uint16_t> key{batch.map, sender};
+  auto& pending = pending_global_[key];
   if (!pending.empty() && (pending.front().epoch != batch.epoch || pending.front().batches != batch.batches)) {
     if (pending.front().epoch > batch.epoch) return std::nullopt;  // a late batch of an older update
     pending.clear();
@@ -111,7 +112,7 @@ std::optional<std::vector<MapRecord>> Observer::collectGlobal(MapRecord&& batch)
   pending.push_back(std::move(batch));
   if (pending.size() < pending.front().batches) return std::nullopt;
   std::vector<MapRecord> all = std::move(pending);
-  pending_global_.erase(all.front().map);
+  pending_global_.erase(key);
   return all;
 }
 

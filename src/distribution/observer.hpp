@@ -6,6 +6,7 @@
 //
 // Locking: its own mutex, a leaf: taken after a map's mutex or alone, never the other way.
 #include <functional>
+#include <map>
 #include <mutex>
 #include <optional>
 #include <unordered_map>
@@ -39,8 +40,8 @@ class Observer {
   bool erasedPoint(Id id) const;
   // An authoritative snapshot lists these as alive: their tombstones go before it is recorded.
   void revive(const MapRecord& snapshot);
-  // A global map's batches until the last one is in; returns all batches then.
-  std::optional<std::vector<MapRecord>> collectGlobal(MapRecord&& batch);
+  // A global map's batches from `sender` until the last one is in; returns all batches then.
+  std::optional<std::vector<MapRecord>> collectGlobal(MapRecord&& batch, uint16_t sender);
   bool hasPoint(Id id) const;
   StateDigest digest() const;
   size_t keyframeCount() const;
@@ -51,9 +52,11 @@ class Observer {
   std::unordered_map<Id, PointRecord> points_;
   std::unordered_map<Id, Id> point_map_;  // the map each point record came with
   std::unordered_set<Id> erased_keyframes_, erased_points_;
-  // Global map batches being collected, by map, for one epoch at a time (a newer epoch drops
-  // an unfinished older one).
-  std::unordered_map<Id, std::vector<MapRecord>> pending_global_;
+  // Global map batches being collected, by map and sender, for one epoch at a time (a newer
+  // epoch drops an unfinished older one). Epochs are counted by each sender: a gateway that
+  // joins gets TR's hand-over and LC's next update of the same map at once, and collected by
+  // map alone, each dropped the other's batches as those of an older update (session 22).
+  std::map<std::pair<Id, uint16_t>, std::vector<MapRecord>> pending_global_;
 };
 
 }  // namespace hiveslam::distribution

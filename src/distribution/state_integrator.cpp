@@ -170,6 +170,12 @@ bool StateIntegrator::stale(const core::Map& map, uint64_t label) const {
   return it != epochs_.end() && !it->second.empty() && label < it->second.begin()->first;
 }
 
+bool StateIntegrator::current(const core::Map& map, uint64_t label) const {
+  std::lock_guard lock(epochs_mutex_);
+  if (const Frame* f = frameOf(map, label)) return f->core_epoch == map.epoch;
+  return label == 0 && map.epoch == 0;
+}
+
 StateIntegrator::Added StateIntegrator::addKeyframe(const KeyFrameMessage& m, uint64_t label) {
   Added out;
   auto map = mapFor(m.keyframe.map);
@@ -248,9 +254,10 @@ StateIntegrator::Added StateIntegrator::addKeyframe(const KeyFrameMessage& m, ui
 }
 
 std::vector<PointRecord> StateIntegrator::carryNewPoints(const core::Map& map, const MapRecord& m) {
-  // The points were triangulated in the frame the sender had before it applied this node's
-  // latest global map, like the window keyframes' poses in the same record. Each is carried
-  // through a window keyframe held here: the one that made it, else the first one.
+  // The points were triangulated in the frame the sender had (before it applied this node's
+  // latest global map, or after it applied one still on its way here), like the window
+  // keyframes' poses in the same record. Each is carried through a window keyframe held here:
+  // the one that made it, else the first one.
   std::unordered_map<Id, const Eigen::Vector3d*> recorded;
   for (const auto& q : m.points) recorded.emplace(q.id, &q.position);
   struct Carry {
@@ -296,16 +303,20 @@ std::vector<PointRecord> StateIntegrator::carryNewPoints(const core::Map& map, c
   return out;
 }
 
+void StateIntegrator::takeNewPoints(core::Map& map, const MapRecord& m) {
+  // Points no keyframe here can carry come with the sender's next record in this frame.
+  for (const auto& p : carryNewPoints(map, m)) {
+    applyPoint(map, p);
+    observer_.record(p, m.map);
+  }
+}
+
 void StateIntegrator::applyLocal(const MapRecord& m) {
   auto map = slam_.findMap(m.map);
   if (!map || map->merged_into.load()) return;
   std::lock_guard lock(map->mutex);
   if (stale(*map, m.epoch)) {
-    // Points no keyframe here can carry come with the sender's next fresh record.
-    for (const auto& p : carryNewPoints(*map, m)) {
-      applyPoint(*map, p);
-      observer_.record(p, m.map);
-    }
+    takeNewPoints(*map, m);
     applyErasures(*map, m);
     for (Id id : m.erased_keyframes) observer_.eraseKeyframe(id);
     for (Id id : m.erased_points) observer_.erasePoint(id);
@@ -334,6 +345,22 @@ void StateIntegrator::applyLocal(const MapRecord& m) {
   }
   for (Id id : m.erased_points) observers(id);
   applyErasures(*map, m);
+  for (core::KeyFrame* kf : relinked)
+    if (!kf->bad) kf->updateConnections();
+}
+
+void StateIntegrator::applyAhead(const MapRecord& m) {
+  auto map = slam_.findMap(m.map);
+  if (!map || map->merged_into.load()) return;
+  std::lock_guard lock(map->mutex);
+  if (current(*map, m.epoch)) return;  // its global map is in: it is applied as it is
+  takeNewPoints(*map, m);
+  // Links name points by id: they hold in any frame. Tracking finds points through the
+  // keyframes that see them, so the new points are of use only linked.
+  std::set<core::KeyFrame*, core::ById> relinked;
+  for (const auto& k : m.keyframes)
+    if (auto it = map->keyframes.find(k.id); it != map->keyframes.end() && relink(*map, *it->second, k))
+      relinked.insert(it->second.get());
   for (core::KeyFrame* kf : relinked)
     if (!kf->bad) kf->updateConnections();
 }

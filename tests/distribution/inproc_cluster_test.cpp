@@ -76,7 +76,8 @@ struct ClusterRun {
   size_t maps_tr = 0, maps_lm = 0, maps_lc = 0;
 };
 
-// Frames at which the mapping node leaves, and at which a fresh one (new id, empty maps) joins.
+// Frames at which the mapping node leaves, and at which it comes back: a new incarnation under
+// the same id, with empty maps, as a restarted device would be.
 struct Outage {
   int leaves = -1, returns = -1;
 };
@@ -95,11 +96,11 @@ ClusterRun runThreeNodes(const std::string& trajectory, int frames, Outage outag
   core::SlamSystem tr(core::SlamSettings{}, camera, Mode::Offline, voc, 1);
   core::SlamSystem lm(core::SlamSettings{}, camera, Mode::Offline, voc, 2);
   core::SlamSystem lc(core::SlamSettings{}, camera, Mode::Offline, voc, 3);
-  core::SlamSystem lm2(core::SlamSettings{}, camera, Mode::Offline, voc, 4);
+  core::SlamSystem lm2(core::SlamSettings{}, camera, Mode::Offline, voc, 2);
   communication::InProcNetwork network;
   auto e_tr = network.endpoint(), e_lm = network.endpoint(), e_lc = network.endpoint(), e_lm2 = network.endpoint();
   DistributedNode n_lm(lm, *e_lm, {Task::Mapping, 2, "lm", {}});
-  DistributedNode n_lm2(lm2, *e_lm2, {Task::Mapping, 4, "lm2", {}});
+  DistributedNode n_lm2(lm2, *e_lm2, {Task::Mapping, 2, "lm", {}});
   DistributedNode n_lc(lc, *e_lc, {Task::LoopClosing, 3, "lc", {}});
   DistributedNode n_tr(tr, *e_tr, {Task::Tracking, 1, "tr", {}});
   n_lm.start();
@@ -165,11 +166,12 @@ TEST(InProcCluster, ThreeNodesTrackCloseTheLoopAndAgree) {
   EXPECT_EQ(run.mapped_by_tr, 0);  // TR mapped nothing itself
 }
 
-// The mapping node leaves a third of the way round; TR maps alone (LC stays). A fresh mapping
-// node joins at two thirds: TR hands it the map so far and mapping back. It must take over
-// the whole map, not start a second copy from the keyframes that come after it joined, and
-// the loop is still closed with every node holding the same map at the end (it once ended
-// with the new node holding only what it mapped itself, and 4 nodes' worth of disagreement).
+// The mapping node leaves a third of the way round; TR maps alone (LC stays). It comes back at
+// two thirds, restarted under its old id: TR hands it the map so far and mapping back. It must
+// take over the whole map, not start a second copy from the keyframes that come after it
+// joined (it once ended holding only what it mapped itself), and the points it makes must not
+// reuse the ids of those its first incarnation made (they once did, and overwrote them). The
+// loop is still closed with every node holding the same map at the end.
 TEST(InProcCluster, AMappingNodeThatJoinsMidRunTakesTheWholeMapOver) {
   const ClusterRun run = runThreeNodes("loop", 500, {160, 330});
   EXPECT_GT(run.tracked, run.frames * 9 / 10);

@@ -137,12 +137,12 @@ TEST(NodeProcesses, TrackingTakesMappingBackWhenTheMappingNodeDies) {
   EXPECT_GT(tr["mapping"]["keyframes_processed"].get<int>(), 0);  // it mapped after the LM left
 }
 
-// The mapping node dies at 20% of the frames and a fresh one (new id, nothing held) starts at
-// 50%: TR notices the death after the 2 s lease, maps alone, then hands the newcomer the map
-// it kept over DDS once the newcomer's readers have matched, and gives mapping up to it. At
-// the end all three hold the same map. (A newcomer that starts after TR has gone waits for
+// The mapping node dies at 20% of the frames and is started again at 50%, as it was (the same
+// id, nothing held): TR notices the death after the 2 s lease, maps alone, then hands the
+// newcomer the map it kept over DDS once the newcomer's readers have matched, and gives
+// mapping up to it. At the end all three hold the same map. (A newcomer that starts after TR has gone waits for
 // keyframes for good: it gets a minute after TR's end, then it is stopped.)
-TEST(NodeProcesses, AFreshMappingNodeTakesTheMapOverFromTracking) {
+TEST(NodeProcesses, ARestartedMappingNodeTakesTheMapOverFromTracking) {
   testing::TempDir out;
   const std::string bin = HIVESLAM_BINARY, domain = " --domain " + std::to_string(200 + getpid() % 30);
   const std::string tr_log = (out / "tr.log").string();
@@ -154,7 +154,7 @@ TEST(NodeProcesses, AFreshMappingNodeTakesTheMapOverFromTracking) {
       " 2>&1 & lm=$!; " + bin + " node --task lc" + domain + " --out " + (out / "lc").string() + " > " +
       (out / "lc.log").string() + " 2>&1 & lc=$!; " + bin + " node --task tr " + sequence().string() + domain +
       " --expect lm,lc --realtime --out " + (out / "tr").string() + " > " + tr_log + " 2>&1 & tr=$!; " + reached(48) +
-      "kill -9 $lm; " + reached(120) + bin + " node --task lm --id 4" + domain + " --out " + (out / "lm2").string() +
+      "kill -9 $lm; " + reached(120) + bin + " node --task lm" + domain + " --out " + (out / "lm2").string() +
       " > " + (out / "lm2.log").string() + " 2>&1 & lm2=$!; wait $tr; status=$?; " +
       "for i in $(seq 600); do kill -0 $lm2 2>/dev/null || break; sleep 0.1; done; kill $lm2 $lc 2>/dev/null; wait; exit $status";
   const int status = std::system(("timeout 300 bash -c '" + run + "'").c_str());

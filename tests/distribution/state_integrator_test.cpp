@@ -249,6 +249,48 @@ TEST_F(EpochLabels, AKeyframeFromFarBehindIsStillRePosed) {
   expectPose(*added.keyframe, m.keyframe.T_made_from * moved(poseAt(0.4), S2));
 }
 
+// The other way round: the sender applied a global map that is still on its way here, so its
+// local map is in a newer frame and waits for it (DistributedNode holds it). Meanwhile its new
+// point is lent to tracking, carried into this node's frame and linked to the keyframe that
+// sees it; poses and known points stay as they are. When the global map lands, the point moves
+// with it, and the record, applied then, puts it where the sender has it.
+TEST_F(EpochLabels, ALocalMapAheadOfItsGlobalMapLendsItsNewPointInTheCurrentFrame) {
+  const core::Sim3 S(Eigen::Quaterniond(Eigen::AngleAxisd(0.3, Eigen::Vector3d::UnitZ())), {2.0, -1.0, 0.5}, 1.2);
+  const Eigen::Vector3d q(0.2, -0.1, 4.0);
+  MapRecord m = staleLocalMap(S * q);
+  m.epoch = 1;
+  for (auto& k : m.keyframes) {
+    k.T_cw = moved(k.T_cw, S);
+    if (k.id != kSecond) continue;
+    k.links = true;
+    k.parent = kFirst;
+    for (int i = 0; i < kPoints; ++i) k.matches.emplace_back(i, 100 + i);
+    k.matches.emplace_back(kPoints, kNewPoint);
+  }
+  for (auto& p : m.points)
+    if (p.id != kNewPoint) p.position = S * p.position;
+
+  integrator_.applyAhead(m);
+  const auto lent = pointHere(kNewPoint);
+  ASSERT_TRUE(lent);
+  EXPECT_LT((*lent - q).norm(), 1e-9) << "at " << lent->transpose() << ", expected " << q.transpose();
+  EXPECT_LT((*pointHere(105) - pointAt(5)).norm(), 1e-12);  // known points wait for the record
+  {
+    auto map = slam_.findMap(kMap);
+    std::lock_guard lock(map->mutex);
+    const core::KeyFrame& second = *map->keyframes.at(kSecond);
+    expectPose(second, poseAt(0.4));
+    ASSERT_TRUE(second.points[kPoints]);
+    EXPECT_EQ(second.points[kPoints]->id, kNewPoint);
+  }
+
+  correct(S, 1);
+  EXPECT_LT((*pointHere(kNewPoint) - S * q).norm(), 1e-9);  // it moved with the correction
+  integrator_.applyLocal(m);
+  EXPECT_LT((*pointHere(kNewPoint) - S * q).norm(), 1e-12);
+  EXPECT_LT((*pointHere(105) - S * pointAt(5)).norm(), 1e-9);
+}
+
 TEST_F(EpochLabels, ANewPointWithNoKeyframeToCarryItWaitsForAFreshRecord) {
   correct(core::Sim3(Eigen::Quaterniond::Identity(), {1.0, 0, 0}, 1.1));
   integrator_.applyLocal(staleLocalMap({0.2, -0.1, 4.0}, false));

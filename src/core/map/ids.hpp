@@ -1,6 +1,11 @@
 #pragma once
 // Keyframe and map point identifiers: unique across nodes without coordination, because the
 // creating node's id sits in the high 16 bits and a per-node counter in the low 48.
+// A node that restarts under the same id must not count from 0 again: its peers still hold
+// the ids its earlier incarnation made, and a second point with one of them would overwrite
+// the first in every map. A distributed node therefore starts its counter at its start time
+// in 10 us ticks since 2024 (distribution/distributed_node.cpp): an incarnation would have to
+// make more than 100,000 ids a second to reach the next one's range, and 48 bits last 89 years.
 #include <atomic>
 #include <cstdint>
 
@@ -16,14 +21,18 @@ class IdGenerator {
   static uint16_t node(Id id) { return static_cast<uint16_t>(id >> 48); }
   // After loading saved maps: this node's next ids come after every id it made before.
   void advancePast(Id id) {
-    if (node(id) != node_) return;
-    const uint64_t next = (id & ((Id{1} << 48) - 1)) + 1;
+    if (node(id) == node_) advanceTo((id & kCounterMask) + 1);
+  }
+  // The counter goes on from at least `counter` (never back).
+  void advanceTo(uint64_t counter) {
+    counter &= kCounterMask;
     uint64_t current = counter_.load();
-    while (current < next && !counter_.compare_exchange_weak(current, next)) {
+    while (current < counter && !counter_.compare_exchange_weak(current, counter)) {
     }
   }
 
  private:
+  static constexpr uint64_t kCounterMask = (Id{1} << 48) - 1;
   uint16_t node_;
   std::atomic<uint64_t> counter_{0};
 };

@@ -79,6 +79,8 @@ class SlamSystem {
   std::shared_ptr<Map> findMap(Id id) const;
   KeyframeDatabase& database() { return database_; }
   const std::vector<double>& scales() const { return extractor_.scales(); }
+  // Before the first frame: the ids this node makes count on from `counter` (see ids.hpp).
+  void startIdsAt(uint64_t counter) { ids_.advanceTo(counter); }
   const place::Vocabulary* vocabulary() const { return vocabulary_.get(); }
   // The end of a run: blocks until the queued keyframes of the hosted modules are done, then,
   // where loop closing is hosted, runs the final global BA of every map
