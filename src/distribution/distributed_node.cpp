@@ -149,7 +149,7 @@ void DistributedNode::onPeer(const PeerInfo& peer, bool present) {
 
 void DistributedNode::sendMapsTo(const PeerInfo& peer) {
   // Every task reads the map topic; keyframes go from here to an LM or an LC only.
-  Newcomer newcomer{peer.node, {Topic::LmMap}, std::chrono::milliseconds(options_.settings.handover_wait_ms)};
+  Newcomer newcomer{peer.node, {Topic::LmMap}};
   const Plan p = plan();
   if (p.keyframes_to_lm && peer.task == Task::Mapping) newcomer.reads.push_back(Topic::TrKeyframes);
   if (p.keyframes_to_lc && peer.task == Task::LoopClosing) newcomer.reads.push_back(Topic::LmKeyframes);

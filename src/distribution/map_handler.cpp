@@ -144,7 +144,7 @@ void MapHandler::sendGlobal(const std::shared_ptr<core::Map>& map, uint64_t epoc
     g.topic = topic;
     g.merged = std::move(merged_maps);
     g.full = full;
-    g.reader_deadline = Clock::now() + newcomer.wait;
+    g.reader_deadline = Clock::now() + std::chrono::milliseconds(settings_.handover_wait_ms);
     g.newcomer = std::move(newcomer);
     for (auto it = globals_.begin(); it != globals_.end();)
       if (it->map == map && it->topic == topic && it != globals_.begin()) {

@@ -28,7 +28,6 @@ namespace hiveslam::distribution {
 struct Newcomer {
   uint16_t node = 0;
   std::vector<communication::Topic> reads;
-  std::chrono::milliseconds wait{0};
 };
 
 class MapHandler {
@@ -58,8 +57,8 @@ class MapHandler {
   // `full`: every point with its full record and every keyframe with its links (a snapshot for
   // a node that may have missed updates: a newcomer, or the end of a run). With a newcomer
   // the keyframes go with their features (it holds none of them), and the map is taken only
-  // once the newcomer reads every topic it gets from this node (up to `wait`): what goes
-  // before never reaches it, and what goes after the capture is not in the snapshot.
+  // once the newcomer reads every topic it gets from this node (up to `handover_wait_ms`):
+  // what goes before never reaches it, and what goes after the capture is not in the snapshot.
   void sendGlobal(const std::shared_ptr<core::Map>& map, uint64_t epoch, communication::Topic topic,
                   std::vector<core::Id> merged_maps, bool full = false, Newcomer newcomer = {});
   // Sends everything pending (dirty keyframes, global maps), then stops the thread.

@@ -255,7 +255,7 @@ std::shared_ptr<KeyFrame> Tracker::nearestKeyframe(const Tracked& c) const {
     if (!c.points[i] || c.outlier[i] || c.points[i]->bad) continue;
     for (const auto& [kf, idx] : c.points[i]->observations) {
       if (kf->bad || !seen.insert(kf).second) continue;
-      const double d2 = (kf->T_cw.inverse().translation() - center).squaredNorm();
+      const double d2 = (kf->center() - center).squaredNorm();
       if (d2 < best_d2) {
         best_d2 = d2;
         best = kf->shared_from_this();
