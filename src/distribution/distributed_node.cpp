@@ -73,11 +73,18 @@ DistributedNode::DistributedNode(core::SlamSystem& slam, communication::Transpor
   hooks.local_applied = [this](const MapRecord& m) {
     {
       std::lock_guard lock(mutex_);
-      for (core::Id k : m.mapped) outstanding_.erase(k);
+      for (core::Id k : m.mapped) {
+        outstanding_.erase(k);
+        unanswered_.erase(k);
+      }
     }
     changed_.notify_all();
   };
   hooks.control = [this](const Message& m, Topic t) { onControl(m, t); };
+  // A node that gave mapping up still maps the keyframes it had taken: a newcomer's snapshot
+  // waits for them. Taken before, the culling and the points that came after it reached no
+  // one, and this node ended the run a keyframe short of the others.
+  hooks.settled = [this] { return plan().mapping || slam_.mappingIdle(); };
   handler_ = std::make_unique<MapHandler>(transport_, integrator_, observer_, ledger_, options_.settings, options_.id,
                                           std::move(hooks));
   slam_.setEvents(this);
@@ -181,8 +188,10 @@ void DistributedNode::awaitMap(core::Id id) {
 void DistributedNode::applyPlan() {
   std::vector<Topic> add, remove;
   Plan p;
+  std::map<core::Id, std::chrono::steady_clock::time_point> orphans;  // by id: mapped in order
   {
     std::lock_guard lock(mutex_);
+    const Plan before = plan_;
     uint8_t present = 0;
     for (const auto& [id, peer] : peers_) present |= taskBit(peer.task);
     p = decide(options_.task, present);
@@ -194,8 +203,27 @@ void DistributedNode::applyPlan() {
       if (std::find(p.subscriptions.begin(), p.subscriptions.end(), t) == p.subscriptions.end()) remove.push_back(t);
     subscribed_ = p.subscriptions;
     if (!changed && add.empty() && remove.empty()) return;
+    if (p.mapping && !before.mapping) {
+      orphans.swap(outstanding_);
+      orphans.insert(unanswered_.begin(), unanswered_.end());
+      unanswered_.clear();
+    }
   }
   slam_.setHosting({p.mapping, p.loop_closing});
+  // Mapping taken back from a node that left: the keyframes it was sent and never acknowledged
+  // are mapped here (tracked against, never triangulated, they left TR short of new points
+  // just where it tracks now).
+  for (const auto& map : orphans.empty() ? std::vector<std::shared_ptr<core::Map>>{} : slam_.liveMaps()) {
+    std::vector<std::shared_ptr<core::KeyFrame>> lost;
+    {
+      std::lock_guard lock(map->mutex);
+      for (const auto& [id, when] : orphans)
+        if (auto it = map->keyframes.find(id); it != map->keyframes.end()) lost.push_back(it->second);
+    }
+    for (const auto& kf : lost) slam_.submit(map, kf, core::SlamSystem::Module::Mapping);
+    std::lock_guard lock(mutex_);
+    keyframes_taken_back_ += static_cast<int>(lost.size());
+  }
   for (Topic t : remove) transport_.unsubscribe(t);
   for (Topic t : add) {
     if (isKeyframeTopic(t))
@@ -297,8 +325,15 @@ void DistributedNode::onGlobal(std::vector<MapRecord>&& batches, Topic topic) {
     }
   }
   if (ignore) {
-    // Still, what is new here (points LM made) and what LM erased is taken.
+    // Still, what is new here (points LM made) and what LM erased is taken, and the keyframes
+    // a snapshot brings that this node never got: the one a mapping node mapped as it died,
+    // those the node that took mapping back mapped after it gave mapping up again. Without
+    // them LC ended such runs two keyframes short of TR and LM.
     for (const auto& b : batches) integrator_.applyLocal(b);  // labelled older: stale here
+    for (const auto& a : integrator_.addMissing(batches)) {
+      std::lock_guard lock(a.map->mutex);
+      core::insertKeyframe(*a.map, *a.keyframe, slam_.scales(), &slam_.database());
+    }
     return;
   }
   integrator_.applyGlobal(batches, true);
@@ -429,7 +464,15 @@ bool DistributedNode::remoteIdle() const {
   // An acknowledgement that never came (the keyframe was dropped at the gateway: its map was
   // merged meanwhile, or the gateway changed) must not hold keyframes back for good.
   const auto lost = std::chrono::steady_clock::now() - std::chrono::milliseconds(options_.settings.remote_mapping_wait_ms);
-  std::erase_if(outstanding_, [&](const auto& o) { return o.second < lost; });
+  for (auto it = outstanding_.begin(); it != outstanding_.end();)
+    if (it->second < lost) {
+      unanswered_.insert(*it);
+      it = outstanding_.erase(it);
+    } else {
+      ++it;
+    }
+  constexpr size_t kUnansweredKept = 64;  // the mapping node's last seconds, at most
+  while (unanswered_.size() > kUnansweredKept) unanswered_.erase(unanswered_.begin());
   return outstanding_.empty();
 }
 
@@ -484,6 +527,7 @@ nlohmann::json DistributedNode::report(double seconds) const {
     j["globals_ignored"] = globals_ignored_;
     j["local_maps_held"] = local_maps_held_;
     j["maps_awaited"] = maps_awaited_;
+    j["keyframes_taken_back"] = keyframes_taken_back_;
     j["stale_points_carried"] = integrator_.stalePointsCarried();
     j["peers"] = peers_.size();
   }

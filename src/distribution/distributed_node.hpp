@@ -100,6 +100,9 @@ class DistributedNode final : public core::SystemEvents {
   std::map<core::Id, uint64_t> published_;  // LC: last global epoch published, per map
   // TR: keyframes sent, not yet acknowledged as mapped (MapRecord::mapped), with when they went.
   mutable std::map<core::Id, std::chrono::steady_clock::time_point> outstanding_;
+  // TR: those no longer waited for (remote_mapping_wait_ms passed). Mapped here if this node
+  // takes mapping back: the mapping node died before it mapped them.
+  mutable std::map<core::Id, std::chrono::steady_clock::time_point> unanswered_;
   std::vector<MapRecord> held_;             // local maps ahead of synced_, in arrival order
   bool done_ = false, lc_done_ = false;
   bool stopping_ = false;  // stop() has begun: no finisher may start any more
@@ -108,6 +111,7 @@ class DistributedNode final : public core::SystemEvents {
   int local_maps_held_ = 0;  // local maps that came ahead of their global update
   uint64_t incarnation_ = 0;
   int maps_awaited_ = 0;  // keyframes that waited for a hand-over
+  int keyframes_taken_back_ = 0;  // unacknowledged keyframes mapped here after the LM left
   uint64_t knownEpoch(core::Id map) const;  // the newer of synced_ and published_; mutex_ held
   void releaseHeld(core::Id map);           // applies the held local maps the epoch has reached
   std::thread finisher_;  // the end-of-run exchange (LM, LC)

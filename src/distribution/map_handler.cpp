@@ -181,8 +181,11 @@ void MapHandler::loop() {
       busy_ = true;
       lock.unlock();
       const auto reads = [&](Topic t) { return transport_.peerReads(t, g.newcomer.node); };
-      if (g.newcomer.node && g.batches.empty() && now < g.reader_deadline &&
-          !std::all_of(g.newcomer.reads.begin(), g.newcomer.reads.end(), reads)) {
+      const auto ready = [&] {
+        return std::all_of(g.newcomer.reads.begin(), g.newcomer.reads.end(), reads) &&
+               (!hooks_.settled || hooks_.settled());
+      };
+      if (g.newcomer.node && g.batches.empty() && now < g.reader_deadline && !ready()) {
         lock.lock();
         globals_.push_front(std::move(g));
         next_global = Clock::now() + std::chrono::milliseconds(10);

@@ -42,6 +42,9 @@ class MapHandler {
     std::function<void(const MapRecord&)> local_applied;
     // A control packet, in order with the maps of its topic.
     std::function<void(const communication::Message&, communication::Topic)> control;
+    // Whether this node's maps are settled enough for a newcomer's snapshot: what changes
+    // them after the capture must also reach the newcomer by a later message.
+    std::function<bool()> settled;
   };
   MapHandler(communication::Transport& transport, StateIntegrator& integrator, Observer& observer,
              SentLedger& ledger, const DistributionSettings& settings, uint16_t node, Hooks hooks);
@@ -57,8 +60,9 @@ class MapHandler {
   // `full`: every point with its full record and every keyframe with its links (a snapshot for
   // a node that may have missed updates: a newcomer, or the end of a run). With a newcomer
   // the keyframes go with their features (it holds none of them), and the map is taken only
-  // once the newcomer reads every topic it gets from this node (up to `handover_wait_ms`):
-  // what goes before never reaches it, and what goes after the capture is not in the snapshot.
+  // once the newcomer reads every topic it gets from this node and Hooks::settled holds (up to
+  // `handover_wait_ms`): what goes before never reaches it, and what goes after the capture is
+  // not in the snapshot.
   void sendGlobal(const std::shared_ptr<core::Map>& map, uint64_t epoch, communication::Topic topic,
                   std::vector<core::Id> merged_maps, bool full = false, Newcomer newcomer = {});
   // Sends everything pending (dirty keyframes, global maps), then stops the thread.

@@ -24,6 +24,8 @@ void Observer::record(const PointRecord& p, Id map) {
   if (erased_points_.count(p.id)) return;
   if (map != kNoId) point_map_[p.id] = map;
   auto it = points_.find(p.id);
+  // A position alone is not a point yet (as in the core map: StateIntegrator::applyPoint).
+  if (it == points_.end() && !p.full) return;
   if (it == points_.end() || p.full) {
     points_[p.id] = p;
   } else {

@@ -40,17 +40,17 @@ std::shared_ptr<core::Map> StateIntegrator::mapFor(Id id) {
   return m;
 }
 
-void StateIntegrator::applyPoint(core::Map& map, const PointRecord& r, bool authoritative) {
+bool StateIntegrator::applyPoint(core::Map& map, const PointRecord& r, bool authoritative) {
   auto it = map.points.find(r.id);
   std::shared_ptr<core::MapPoint> p;
   if (it != map.points.end()) {
     p = it->second;
     p->position = r.position;
   } else {
-    if (!r.full) return;  // its full record is on the way (or it was erased meanwhile)
+    if (!r.full) return false;  // its full record is on the way (or it was erased meanwhile)
     // Erased here; the sender had not heard of it yet. Brought back, it would live on as a
     // duplicate of the point that replaced it, and only here.
-    if (!authoritative && observer_.erasedPoint(r.id)) return;
+    if (!authoritative && observer_.erasedPoint(r.id)) return false;
     p = std::make_shared<core::MapPoint>(r.id, r.position, r.first_keyframe);
     map.add(p);
   }
@@ -61,6 +61,7 @@ void StateIntegrator::applyPoint(core::Map& map, const PointRecord& r, bool auth
     p->min_distance = r.min_distance;
     p->max_distance = r.max_distance;
   }
+  return true;
 }
 
 bool StateIntegrator::relink(core::Map& map, core::KeyFrame& kf, const KeyFrameRecord& r) {
@@ -188,7 +189,12 @@ StateIntegrator::Added StateIntegrator::addKeyframe(const KeyFrameMessage& m, ui
   applied.reserve(m.points.size());
   {
     std::lock_guard lock(map->mutex);
-    if (map->keyframes.count(kf->id)) return out;
+    if (auto it = map->keyframes.find(kf->id); it != map->keyframes.end()) {
+      out.map = map;
+      out.keyframe = it->second;
+      out.held = true;
+      return out;
+    }
     if (m.keyframe.made_from != kNoId)
       if (auto it = map->keyframes.find(m.keyframe.made_from); it != map->keyframes.end())
         kf->made_from = it->second.get();
@@ -213,7 +219,7 @@ StateIntegrator::Added StateIntegrator::addKeyframe(const KeyFrameMessage& m, ui
           if (!map->points.count(p.id)) {
             // The same point seen from the keyframe, in the current frame and scale.
             p.position = kf->T_cw.inverse() * (change * (m.keyframe.T_cw * p.position));
-            applyPoint(*map, p);
+            if (!applyPoint(*map, p)) continue;
             applied.push_back(p);
             ++stale_points_carried_;
           }
@@ -221,8 +227,8 @@ StateIntegrator::Added StateIntegrator::addKeyframe(const KeyFrameMessage& m, ui
       // else: nothing to carry it by; its new points wait for a fresh record, and the
       // keyframe's pose for the sender's next local map.
     } else {
-      for (const auto& p : m.points) applyPoint(*map, p);
-      applied = m.points;
+      for (const auto& p : m.points)
+        if (applyPoint(*map, p)) applied.push_back(p);
     }
     for (size_t i = 0; i < companions.size(); ++i) {
       auto& c = companions[i];
@@ -250,6 +256,23 @@ StateIntegrator::Added StateIntegrator::addKeyframe(const KeyFrameMessage& m, ui
   observer_.record(placed);
   out.map = map;
   out.keyframe = kf;
+  return out;
+}
+
+std::vector<StateIntegrator::Added> StateIntegrator::addMissing(const std::vector<MapRecord>& batches) {
+  std::vector<const KeyFrameRecord*> full;
+  for (const auto& b : batches)
+    for (const auto& k : b.keyframes)
+      if (k.full) full.push_back(&k);
+  std::sort(full.begin(), full.end(), [](auto* a, auto* b) { return a->id < b->id; });
+  std::vector<Added> out;
+  if (full.empty() || !slam_.findMap(batches.front().map)) return out;
+  for (const KeyFrameRecord* k : full) {
+    KeyFrameMessage m;
+    m.keyframe = *k;
+    if (auto added = addKeyframe(m, batches.front().epoch); added.keyframe && !added.held)
+      out.push_back(std::move(added));
+  }
   return out;
 }
 
@@ -305,10 +328,8 @@ std::vector<PointRecord> StateIntegrator::carryNewPoints(const core::Map& map, c
 
 void StateIntegrator::takeNewPoints(core::Map& map, const MapRecord& m) {
   // Points no keyframe here can carry come with the sender's next record in this frame.
-  for (const auto& p : carryNewPoints(map, m)) {
-    applyPoint(map, p);
-    observer_.record(p, m.map);
-  }
+  for (const auto& p : carryNewPoints(map, m))
+    if (applyPoint(map, p)) observer_.record(p, m.map);
 }
 
 void StateIntegrator::applyLocal(const MapRecord& m) {
@@ -378,7 +399,15 @@ void StateIntegrator::applyGlobal(const std::vector<MapRecord>& batches, bool au
   for (const auto& b : batches)
     for (const auto& k : b.keyframes)
       if (k.full) with_features.push_back(&k);
-  auto map = with_features.empty() ? slam_.findMap(batches.front().map) : mapFor(batches.front().map);
+  // A map new here joins the atlas only once it is filled: a newcomer's keyframes wait for the
+  // map to exist (DistributedNode::awaitMap), and one let in while the snapshot's bags of words
+  // were computed became the empty map's origin and first keyframe.
+  auto map = slam_.findMap(batches.front().map);
+  const bool new_map = !map && !with_features.empty();
+  if (new_map) {
+    map = std::make_shared<core::Map>(batches.front().map);
+    map->journal_on = true;
+  }
   if (!map || map->merged_into.load()) return;
   std::vector<std::pair<std::shared_ptr<core::KeyFrame>, const KeyFrameRecord*>> fresh;
   if (!with_features.empty()) {
@@ -397,7 +426,7 @@ void StateIntegrator::applyGlobal(const std::vector<MapRecord>& batches, bool au
       map->absorb(*other);
       slam_.database().moveMap(other.get(), map.get());
     }
-  std::lock_guard lock(map->mutex);
+  std::unique_lock lock(map->mutex);
   // One correction: covered keyframes go to their new poses, the others follow their ancestors.
   core::PoseCorrection c;
   std::vector<Id> kf_ids, point_ids;
@@ -464,6 +493,8 @@ void StateIntegrator::applyGlobal(const std::vector<MapRecord>& batches, bool au
   }
   for (const auto& [id, k] : map->keyframes) k->updateConnections();
   noteEpoch(*map, batches.front().epoch);
+  lock.unlock();
+  if (new_map) slam_.addMap(map);
 }
 
 }  // namespace hiveslam::distribution

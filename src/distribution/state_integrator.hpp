@@ -32,14 +32,23 @@ class StateIntegrator {
   StateIntegrator(core::SlamSystem& slam, Observer& observer) : slam_(slam), observer_(observer) {}
 
   // A new keyframe (with its new points and, for a new map, its first keyframe). Returns the
-  // core keyframe and its map, not yet given to a module; null when it is already known. One
-  // labelled with an older frame is re-posed from where tracking posed it (relative to a
-  // keyframe both nodes hold), and the points it brings move with it.
+  // core keyframe and its map, not yet given to a module; null when its map is gone (merged).
+  // One labelled with an older frame is re-posed from where tracking posed it (relative to a
+  // keyframe both nodes hold), and the points it brings move with it. One held already
+  // (`held`) came first in a hand-over snapshot taken after it was sent: it is returned as it
+  // is (the snapshot's pose is the newer), still to be given to the module it was sent to.
   struct Added {
     std::shared_ptr<core::Map> map;
     std::shared_ptr<core::KeyFrame> keyframe;
+    bool held = false;
   };
   Added addKeyframe(const KeyFrameMessage& m, uint64_t label);
+  // The keyframes a global map brings with their features (a newcomer's snapshot) that this
+  // node does not hold, from a global map it does not apply as a whole (LC takes only the
+  // relay of its own latest update). Each is added as a late keyframe is, re-posed from the
+  // keyframe tracking posed it from, in id order (one may be posed from another). Not yet
+  // given to a module. Call after the batches' new points are in: the keyframes link to them.
+  std::vector<Added> addMissing(const std::vector<MapRecord>& batches);
   // A local map labelled with an older frame than the map's (the sender computed it before it
   // applied this node's latest global map): only what is new here (points, erasures) is taken,
   // the points carried into the current frame; the poses are left to a fresh record.
@@ -65,7 +74,8 @@ class StateIntegrator {
  private:
   std::shared_ptr<core::Map> mapFor(Id id);
   // `authoritative`: the record may bring back a point erased here (see Observer::erasedPoint).
-  void applyPoint(core::Map& map, const PointRecord& r, bool authoritative = false);
+  // Returns whether the map holds the point now: only then does S_full record it.
+  bool applyPoint(core::Map& map, const PointRecord& r, bool authoritative = false);
   // True when the keyframe's point links changed.
   bool relink(core::Map& map, core::KeyFrame& kf, const KeyFrameRecord& r);
   void applyErasures(core::Map& map, const MapRecord& m);

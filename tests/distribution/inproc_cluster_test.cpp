@@ -26,12 +26,18 @@ void expectSameState(const StateDigest& a, const StateDigest& b, const char* wha
   EXPECT_EQ(a.keyframes.size(), b.keyframes.size()) << what;
   EXPECT_EQ(a.points.size(), b.points.size()) << what;
   int missing = 0;
+  std::string missing_what;  // the first few, for the failure message
+  const auto miss = [&](const char* kind, core::Id id) {
+    if (++missing <= 4)
+      missing_what += std::string(" ") + kind + " " + std::to_string(id) + " (node " +
+                      std::to_string(core::IdGenerator::node(id)) + ")";
+  };
   double worst = 0;
   std::string worst_what;  // which object, for the failure message
   for (const auto& [id, T] : a.keyframes) {
     auto it = b.keyframes.find(id);
     if (it == b.keyframes.end()) {
-      ++missing;
+      miss("missing keyframe", id);
       continue;
     }
     const double d = (T.inverse().translation() - it->second.inverse().translation()).norm();
@@ -43,7 +49,7 @@ void expectSameState(const StateDigest& a, const StateDigest& b, const char* wha
   for (const auto& [id, p] : a.points) {
     auto it = b.points.find(id);
     if (it == b.points.end()) {
-      ++missing;
+      miss("missing point", id);
       continue;
     }
     const double d = (p - it->second).norm();
@@ -52,7 +58,12 @@ void expectSameState(const StateDigest& a, const StateDigest& b, const char* wha
       worst_what = "point " + std::to_string(id) + " (node " + std::to_string(core::IdGenerator::node(id)) + ")";
     }
   }
-  EXPECT_EQ(missing, 0) << what;
+  // And the other way round: what only the second holds.
+  for (const auto& [id, T] : b.keyframes)
+    if (!a.keyframes.count(id)) miss("extra keyframe", id);
+  for (const auto& [id, p] : b.points)
+    if (!a.points.count(id)) miss("extra point", id);
+  EXPECT_EQ(missing, 0) << what << ":" << missing_what;
   EXPECT_LT(worst, 1e-3) << what << ": " << worst_what;
 }
 

@@ -234,6 +234,55 @@ TEST_F(EpochLabels, AKeyframeMadeBeforeTheCorrectionIsRePosedWithItsPointsScaleI
   EXPECT_LT((*pointHere(kNewPoint) - S * p.position).norm(), 1e-9);
 }
 
+// LC takes only the relay of its own latest update; a newcomer's snapshot labelled with an
+// older one is applied as a stale local map. It may bring a keyframe LC never got (the one a
+// mapping node mapped as it died): that keyframe is added, re-posed into the current frame,
+// and linked to the snapshot's points.
+TEST_F(EpochLabels, ASnapshotFromAnOlderFrameStillBringsTheKeyframesThisNodeLacks) {
+  const core::Sim3 S(Eigen::Quaterniond(Eigen::AngleAxisd(0.2, Eigen::Vector3d::UnitX())), {0.5, 2.0, -1.0}, 1.2);
+  correct(S);
+  MapRecord snapshot = staleLocalMap(Eigen::Vector3d(0.3, 0.2, 4.5));
+  snapshot.kind = MapRecord::Kind::Global;
+  snapshot.points.back().first_keyframe = 13;
+  KeyFrameMessage lacked = keyframeOnSecond(poseAt(0.4));
+  lacked.keyframe.matches.emplace_back(kPoints, kNewPoint);
+  snapshot.keyframes.push_back(lacked.keyframe);  // with its features, as a snapshot carries it
+
+  integrator_.applyLocal(snapshot);
+  const auto added = integrator_.addMissing({snapshot});
+  ASSERT_EQ(added.size(), 1u);
+  EXPECT_EQ(added[0].keyframe->id, 13u);
+  expectPose(*added[0].keyframe, moved(lacked.keyframe.T_cw, S));
+  EXPECT_LT((*pointHere(kNewPoint) - S * Eigen::Vector3d(0.3, 0.2, 4.5)).norm(), 1e-9);
+  {
+    std::lock_guard lock(added[0].map->mutex);
+    core::insertKeyframe(*added[0].map, *added[0].keyframe, slam_.scales(), &slam_.database());
+    ASSERT_TRUE(added[0].keyframe->points[kPoints]);
+    EXPECT_EQ(added[0].keyframe->points[kPoints]->id, kNewPoint);
+    EXPECT_EQ(added[0].keyframe->points[kPoints]->observations.count(added[0].keyframe.get()), 1u);
+  }
+  EXPECT_TRUE(integrator_.addMissing({snapshot}).empty());  // held now
+}
+
+// TR sent a keyframe to the LM that had just joined, and the hand-over snapshot taken after
+// brought it first. The message must still give it to local mapping (it once was dropped as
+// known: nobody mapped it, and TR waited for an acknowledgement that never came), with the
+// snapshot's pose, which is the newer.
+TEST_F(EpochLabels, AKeyframeThatCameFirstInASnapshotIsStillReturnedForItsModule) {
+  const core::Sim3 S(Eigen::Quaterniond::Identity(), {0.2, 0, 0}, 1.0);
+  correct(S);
+  KeyFrameMessage m;
+  m.keyframe.id = kSecond;
+  m.keyframe.map = kMap;
+  m.keyframe.full = true;
+  m.keyframe.frame = featureFrame(kPoints + 1);
+  m.keyframe.T_cw = poseAt(0.4);  // where tracking put it, before the correction
+  const auto added = integrator_.addKeyframe(m, 0);
+  ASSERT_TRUE(added.keyframe);
+  EXPECT_TRUE(added.held);
+  expectPose(*added.keyframe, moved(poseAt(0.4), S));
+}
+
 // A sender many global updates behind (each global map takes a second or more to send, and
 // global BAs follow one another): its label is older than every one this node keeps. It is
 // still from an old frame, and its keyframe is re-posed, not taken as it is.

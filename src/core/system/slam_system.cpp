@@ -79,7 +79,11 @@ void SlamSystem::loopLoop() {
 }
 
 void SlamSystem::setHosting(Hosting hosting) {
-  hosting_mapping_ = hosting.mapping;
+  {
+    // Under the lock that counts queued keyframes: see process().
+    std::lock_guard lock(idle_mutex_);
+    hosting_mapping_ = hosting.mapping;
+  }
   hosting_loop_closing_ = hosting.loop_closing && settings_.loop_closing;
 }
 
@@ -147,6 +151,11 @@ void SlamSystem::drain() {
   while (loop_jobs_pending_ > 0) std::this_thread::sleep_for(std::chrono::milliseconds(5));
 }
 
+bool SlamSystem::mappingIdle() const {
+  std::lock_guard lock(idle_mutex_);
+  return jobs_done_ == jobs_pushed_;
+}
+
 std::function<void()> SlamSystem::beforeBa(const std::shared_ptr<Map>& map, const std::shared_ptr<KeyFrame>& kf) const {
   if (!events_) return {};
   return [this, map, kf] { events_->keyframeTriangulated(map, kf); };
@@ -201,23 +210,29 @@ const FrameRecord& SlamSystem::process(const cv::Mat& gray, double timestamp) {
     r.map = tracker_.map()->id;
   }
   if (out.new_keyframe) {
-    if (remote) {
+    // Mapping may have gone to another node while this frame was tracked. Decided again under
+    // the lock that counts queued keyframes, a newcomer's snapshot (which waits for
+    // mappingIdle) either waits for this keyframe or the keyframe goes to the new mapper.
+    // Queued here after the snapshot, it was mapped by this node alone.
+    bool here = false;
+    {
+      std::lock_guard lock(idle_mutex_);
+      here = hosting_mapping_;
+      if (here && mode_ != Mode::Sequential) ++jobs_pushed_;
+    }
+    if (here && mode_ != Mode::Sequential) {
+      abort_ba_ = true;  // a newer keyframe: the running local BA stops early
+      jobs_.push({tracker_.map(), out.new_keyframe});
+    } else if (!here) {
       {
         std::lock_guard lock(tracker_.map()->mutex);
         insertKeyframe(*tracker_.map(), *out.new_keyframe, extractor_.scales(), &database_);
       }
       if (events_) events_->keyframeCreated(tracker_.map(), out.new_keyframe);
-    } else if (mode_ == Mode::Sequential) {
+    } else {
       mapper_.process(tracker_.map(), out.new_keyframe, nullptr, beforeBa(tracker_.map(), out.new_keyframe));
       if (events_) events_->keyframeMapped(tracker_.map(), out.new_keyframe);
       if (hosting_loop_closing_) closer_.process(tracker_.map(), out.new_keyframe);
-    } else {
-      abort_ba_ = true;  // a newer keyframe: the running local BA stops early
-      {
-        std::lock_guard lock(idle_mutex_);
-        ++jobs_pushed_;
-      }
-      jobs_.push({tracker_.map(), out.new_keyframe});
     }
   }
   records_.push_back(std::move(r));

@@ -87,6 +87,9 @@ class SlamSystem {
   // (SlamSettings::final_global_ba_iterations) on the loop closing thread and waits for it.
   // Only the first call does the final BA.
   void drain();
+  // Whether local mapping has no keyframe queued or in hand (after setHosting took mapping
+  // away, what it still maps changes this node's maps only).
+  bool mappingIdle() const;
 
   const std::vector<FrameRecord>& frames() const { return records_; }
   std::vector<std::shared_ptr<Map>> maps() const;
@@ -135,7 +138,7 @@ class SlamSystem {
   Mode mode_;
   BlockingQueue<MappingJob> jobs_;
   std::atomic<bool> mapping_busy_{false};
-  std::mutex idle_mutex_;
+  mutable std::mutex idle_mutex_;
   std::condition_variable idle_cv_;
   size_t jobs_pushed_ = 0, jobs_done_ = 0;  // guarded by idle_mutex_
   std::atomic<bool> abort_ba_{false};
