@@ -324,24 +324,27 @@ void DistributedNode::onGlobal(std::vector<MapRecord>&& batches, Topic topic) {
       ignore = true;
     }
   }
-  if (ignore) {
-    // Still, what is new here (points LM made) and what LM erased is taken, and the keyframes
-    // a snapshot brings that this node never got: the one a mapping node mapped as it died,
-    // those the node that took mapping back mapped after it gave mapping up again. Without
-    // them LC ended such runs two keyframes short of TR and LM.
-    for (const auto& b : batches) integrator_.applyLocal(b);  // labelled older: stale here
-    for (const auto& a : integrator_.addMissing(batches)) {
-      std::lock_guard lock(a.map->mutex);
-      core::insertKeyframe(*a.map, *a.keyframe, slam_.scales(), &slam_.database());
+  if (!ignore && integrator_.applyGlobal(batches, true)) {
+    {
+      std::lock_guard lock(mutex_);
+      synced_[map_id] = std::max(synced_[map_id], epoch);
     }
+    releaseHeld(map_id);
     return;
   }
-  integrator_.applyGlobal(batches, true);
-  {
+  if (!ignore) {
     std::lock_guard lock(mutex_);
-    synced_[map_id] = std::max(synced_[map_id], epoch);
+    ++globals_ignored_;  // older than the map here (a correction made here, not yet out)
   }
-  releaseHeld(map_id);
+  // Still, what is new here (points LM made) and what LM erased is taken, and the keyframes a
+  // snapshot brings that this node never got: the one a mapping node mapped as it died, those
+  // the node that took mapping back mapped after it gave mapping up again. Without them LC
+  // ended such runs two keyframes short of TR and LM.
+  for (const auto& b : batches) integrator_.applyLocal(b);  // labelled older: stale here
+  for (const auto& a : integrator_.addMissing(batches)) {
+    std::lock_guard lock(a.map->mutex);
+    core::insertKeyframe(*a.map, *a.keyframe, slam_.scales(), &slam_.database());
+  }
 }
 
 uint64_t DistributedNode::knownEpoch(core::Id map) const {

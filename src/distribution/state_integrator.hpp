@@ -61,8 +61,11 @@ class StateIntegrator {
   // (erasures taken early cost figure8 about 1 mm in 4 of 4 real-time runs).
   void applyAhead(const MapRecord& m);
   // All batches of one global map. `authoritative`: the sender's map is the reference (LM's
-  // relay): objects missing from it are erased here.
-  void applyGlobal(const std::vector<MapRecord>& batches, bool authoritative);
+  // relay): objects missing from it are erased here. Returns false, having applied nothing
+  // or only what a stale local map gives, when it is authoritative but its label stands for
+  // a frame the map has left (a correction made here since, its update not yet out): the
+  // caller treats it as an ignored update.
+  bool applyGlobal(const std::vector<MapRecord>& batches, bool authoritative);
   uint64_t stalePointsCarried() const { return stale_points_carried_; }
 
   // With the map's mutex held: the map is now in the frame of global epoch `label` (a global

@@ -417,6 +417,25 @@ TEST_F(EpochLabels, AnAuthoritativeSnapshotErasesTheSameObjectsFromTheMapAndFrom
   EXPECT_TRUE(pointHere(100));
 }
 
+// LC merged or corrected the map and has not published the update yet; the relay of its
+// previous update comes in, labelled with the epoch LC last published. That relay is older
+// than LC's map: taken as authoritative, it erased what the correction brought in (a merged
+// map's keyframes, at LC and then at every node; CI, session 23). It is taken as a stale
+// local map instead, and the caller told so.
+TEST_F(EpochLabels, AnAuthoritativeSnapshotOlderThanACorrectionMadeHereErasesNothing) {
+  constexpr Id kUnknownToSender = 100 + kPoints - 1, kNewer = 200;
+  correct(core::Sim3(Eigen::Quaterniond::Identity(), {0.1, 0, 0}, 1.0), 1);  // published as 1
+  {
+    auto map = slam_.findMap(kMap);
+    std::lock_guard lock(map->mutex);
+    ++map->epoch;  // a correction made here, its label not noted yet
+  }
+  EXPECT_FALSE(integrator_.applyGlobal({snapshotWithoutLastPoint(kNewer)}, true));
+  EXPECT_TRUE(pointHere(kUnknownToSender));
+  EXPECT_TRUE(observer_.hasPoint(kUnknownToSender));
+  EXPECT_LT((*pointHere(100) - (pointAt(0) + Eigen::Vector3d(0.1, 0, 0))).norm(), 1e-9) << "poses of the old frame taken";
+}
+
 // Two maps that have not merged (tracking lost the first and began a second): a snapshot of
 // one says nothing about the other. Its sender's newest ids are newer than everything of the
 // other map, so judged by ids alone S_full would lose the other map, here and at every node
