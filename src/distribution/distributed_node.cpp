@@ -207,6 +207,10 @@ void DistributedNode::applyPlan() {
       orphans.swap(outstanding_);
       orphans.insert(unanswered_.begin(), unanswered_.end());
       unanswered_.clear();
+      // Sent in the LM's last seconds (its lease, then the wait): older ones went unanswered
+      // for another reason (dropped at the gateway, their map merged meanwhile).
+      const auto recent = std::chrono::steady_clock::now() - 5 * std::chrono::milliseconds(options_.settings.remote_mapping_wait_ms);
+      std::erase_if(orphans, [&](const auto& o) { return o.second < recent; });
     }
   }
   slam_.setHosting({p.mapping, p.loop_closing});
@@ -474,7 +478,7 @@ bool DistributedNode::remoteIdle() const {
     } else {
       ++it;
     }
-  constexpr size_t kUnansweredKept = 64;  // the mapping node's last seconds, at most
+  constexpr size_t kUnansweredKept = 64;  // bounded: an LM that lives on never answers them
   while (unanswered_.size() > kUnansweredKept) unanswered_.erase(unanswered_.begin());
   return outstanding_.empty();
 }
