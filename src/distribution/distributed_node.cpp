@@ -217,17 +217,18 @@ void DistributedNode::applyPlan() {
   // Mapping taken back from a node that left: the keyframes it was sent and never acknowledged
   // are mapped here (tracked against, never triangulated, they left TR short of new points
   // just where it tracks now).
-  for (const auto& map : orphans.empty() ? std::vector<std::shared_ptr<core::Map>>{} : slam_.liveMaps()) {
-    std::vector<std::shared_ptr<core::KeyFrame>> lost;
-    {
-      std::lock_guard lock(map->mutex);
-      for (const auto& [id, when] : orphans)
-        if (auto it = map->keyframes.find(id); it != map->keyframes.end()) lost.push_back(it->second);
+  if (!orphans.empty())
+    for (const auto& map : slam_.liveMaps()) {
+      std::vector<std::shared_ptr<core::KeyFrame>> lost;
+      {
+        std::lock_guard lock(map->mutex);
+        for (const auto& [id, when] : orphans)
+          if (auto it = map->keyframes.find(id); it != map->keyframes.end()) lost.push_back(it->second);
+      }
+      for (const auto& kf : lost) slam_.submit(map, kf, core::SlamSystem::Module::Mapping);
+      std::lock_guard lock(mutex_);
+      keyframes_taken_back_ += static_cast<int>(lost.size());
     }
-    for (const auto& kf : lost) slam_.submit(map, kf, core::SlamSystem::Module::Mapping);
-    std::lock_guard lock(mutex_);
-    keyframes_taken_back_ += static_cast<int>(lost.size());
-  }
   for (Topic t : remove) transport_.unsubscribe(t);
   for (Topic t : add) {
     if (isKeyframeTopic(t))

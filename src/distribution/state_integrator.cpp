@@ -30,12 +30,18 @@ bool olderThanSnapshot(Id id, const std::unordered_map<uint16_t, Id>& newest) {
   return it != newest.end() && id < it->second;
 }
 
+// A map first heard of from another node; its erasures are journalled like a map made here.
+std::shared_ptr<core::Map> receivedMap(Id id) {
+  auto m = std::make_shared<core::Map>(id);
+  m->journal_on = true;
+  return m;
+}
+
 }  // namespace
 
 std::shared_ptr<core::Map> StateIntegrator::mapFor(Id id) {
   if (auto m = slam_.findMap(id)) return m->merged_into.load() ? nullptr : m;
-  auto m = std::make_shared<core::Map>(id);
-  m->journal_on = true;
+  auto m = receivedMap(id);
   slam_.addMap(m);
   return m;
 }
@@ -413,10 +419,7 @@ bool StateIntegrator::applyGlobal(const std::vector<MapRecord>& batches, bool au
   // were computed became the empty map's origin and first keyframe.
   auto map = slam_.findMap(batches.front().map);
   const bool new_map = !map && !with_features.empty();
-  if (new_map) {
-    map = std::make_shared<core::Map>(batches.front().map);
-    map->journal_on = true;
-  }
+  if (new_map) map = receivedMap(batches.front().map);
   if (!map || map->merged_into.load()) return false;
   std::vector<std::pair<std::shared_ptr<core::KeyFrame>, const KeyFrameRecord*>> fresh;
   if (!with_features.empty()) {

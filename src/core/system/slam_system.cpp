@@ -214,13 +214,14 @@ const FrameRecord& SlamSystem::process(const cv::Mat& gray, double timestamp) {
     // the lock that counts queued keyframes, a newcomer's snapshot (which waits for
     // mappingIdle) either waits for this keyframe or the keyframe goes to the new mapper.
     // Queued here after the snapshot, it was mapped by this node alone.
-    bool here = false;
+    bool here = false, queued = false;
     {
       std::lock_guard lock(idle_mutex_);
       here = hosting_mapping_;
-      if (here && mode_ != Mode::Sequential) ++jobs_pushed_;
+      queued = here && mode_ != Mode::Sequential;
+      if (queued) ++jobs_pushed_;
     }
-    if (here && mode_ != Mode::Sequential) {
+    if (queued) {
       abort_ba_ = true;  // a newer keyframe: the running local BA stops early
       jobs_.push({tracker_.map(), out.new_keyframe});
     } else if (!here) {
