@@ -176,6 +176,7 @@ RunSummary runSlam(const RunOptions& o) {
   const auto thread_cpu = eval::ResourceMonitor::threadCpuSeconds();
   if (node) node->stop();
   slam.finish();
+  const int frames_refined = slam.refineFrames();
 
   // Trajectory: every tracked frame of the largest map, through its reference keyframe.
   io::Trajectory estimate, keyframes;
@@ -206,6 +207,7 @@ RunSummary runSlam(const RunOptions& o) {
   report["dataset"] = o.dataset;
   report["frames"] = n;
   report["tracked_frames"] = tracked;
+  report["frames_refined"] = frames_refined;
   report["failures"] = slam.failures();
   report["keyframes"] = keyframe_count;
   report["maps"] = maps.size();

@@ -80,6 +80,7 @@ void applySlamSettings(const std::filesystem::path& file, core::SlamSettings& s)
       {"global_ba_iterations", set(s.global_ba_iterations)},
       {"global_ba_every_keyframes", set(s.global_ba_every_keyframes)},
       {"final_global_ba_iterations", set(s.final_global_ba_iterations)},
+      {"refine_frames", set(s.refine_frames)},
       {"vocabulary", set(s.vocabulary)},
       {"seed", set(s.seed)},
   };

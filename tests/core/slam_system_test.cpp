@@ -185,6 +185,57 @@ TEST(SlamSystem, TheEndOfARunBringsOneFinalGlobalBa) {
   }
 }
 
+// A frame is held relative to its reference keyframe as it was tracked. When the map moves in a
+// way that relative pose does not follow (here every point and keyframe scaled by 1.5 about the
+// origin, the keyframes' scale bookkeeping left alone), the frame is off until refineFrames poses
+// it again from its own matches against the final map.
+TEST(SlamSystem, RefinedFramesFollowTheMapTheyWereTrackedIn) {
+  const Sweep sweep;
+  std::vector<cv::Mat> images;
+  io::Trajectory truth;
+  for (int f = 0; f < 120; ++f) {
+    images.push_back(sweep.model.renderImage(f, sweep.rays));
+    truth.add(sweep.model.stamp(f), sweep.model.pose(f));
+  }
+  for (const bool refine : {true, false}) {
+    SlamSettings settings;
+    settings.refine_frames = refine;
+    SlamSystem slam(settings, sweep.camera, SlamSystem::Mode::Sequential);
+    for (int f = 0; f < 120; ++f) slam.process(images[static_cast<size_t>(f)], sweep.model.stamp(f));
+    slam.finish();
+    const auto map = slam.largestMap();
+    ASSERT_TRUE(map);
+    int tracked = 0;
+    const auto ate = [&] {
+      io::Trajectory estimate;
+      tracked = 0;
+      for (const auto& r : slam.frames())
+        if (r.tracked && slam.currentMapId(r.map) == map->id) {
+          estimate.add(r.timestamp, slam.poseOf(r));
+          ++tracked;
+        }
+      return eval::computeAte(truth, estimate).stats.rmse;
+    };
+    const double before = ate();
+    ASSERT_GT(tracked, 90);
+    {
+      std::lock_guard lock(map->mutex);
+      for (auto& [id, p] : map->points) p->position *= 1.5;
+      for (auto& [id, kf] : map->keyframes) kf->T_cw.translation() *= 1.5;
+    }
+    const double moved = ate();
+    const int refined = slam.refineFrames();
+    const double after = ate();
+    if (!refine) {
+      EXPECT_EQ(refined, 0);
+      continue;
+    }
+    EXPECT_GE(refined, 0.95 * tracked);
+    EXPECT_GT(moved, 3 * before) << "the scaled map must leave the frames' relative poses behind";
+    EXPECT_LT(after, 1.1 * before + 0.0005) << before << " m before, " << moved << " m moved";
+  }
+}
+
 TEST(SlamSystem, SequentialModeIsDeterministic) {
   const SlamRun a = runSequence("sweep", 600, 100, 80, 4, SlamSystem::Mode::Sequential), b = runSequence("sweep", 600, 100, 80, 4, SlamSystem::Mode::Sequential);
   ASSERT_EQ(a.estimate.size(), b.estimate.size());

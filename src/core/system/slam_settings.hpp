@@ -74,6 +74,11 @@ struct SlamSettings {
   // 5.2-6.3 -> 5.0-6.1 mm), real-time ones gain (figure8: 9.1 9.8 8.1 -> 5.8 6.9 7.6 mm):
   // docs/BENCHMARKS.md, session 14.
   int final_global_ba_iterations = 50;
+  // At the end of a run (SlamSystem::refineFrames): each tracked frame is posed again against
+  // the final map from the matches it was tracked with. A frame is otherwise held relative to
+  // its reference keyframe as it was when tracked, and keeps the map's error of that moment.
+  // Costs about 24 bytes per match kept (some 6 KB per frame).
+  bool refine_frames = true;
   // Determinism: RANSAC seed
   uint64_t seed = 1;
 };

@@ -5,6 +5,7 @@
 
 #include "common/thread_name.hpp"
 #include "core/mapping/keyframe_insertion.hpp"
+#include "core/optim/pose_optimizer.hpp"
 
 namespace hiveslam::core {
 
@@ -208,6 +209,7 @@ const FrameRecord& SlamSystem::process(const cv::Mat& gray, double timestamp) {
     r.reference = out.reference;
     r.T_c_ref = out.T_c_ref;
     r.map = tracker_.map()->id;
+    r.observations = std::move(out.observations);
   }
   if (out.new_keyframe) {
     // Mapping may have gone to another node while this frame was tracked. Decided again under
@@ -242,6 +244,38 @@ const FrameRecord& SlamSystem::process(const cv::Mat& gray, double timestamp) {
 
 Eigen::Isometry3d SlamSystem::poseOf(const FrameRecord& r) const {
   return r.reference->poseOf(r.T_c_ref).inverse();
+}
+
+int SlamSystem::refineFrames() {
+  // Below this many surviving matches a pose-only fit is weaker than the tracked pose.
+  constexpr size_t kMinMatches = 30;
+  const auto& scales = extractor_.scales();
+  int refined = 0;
+  for (auto& r : records_) {
+    if (!r.tracked || r.observations.size() < kMinMatches) continue;
+    const auto map = findMap(currentMapId(r.map));
+    if (!map) continue;
+    std::vector<PoseObservation> obs;
+    obs.reserve(r.observations.size());
+    Eigen::Isometry3d T_cw;
+    {
+      std::lock_guard lock(map->mutex);
+      for (const auto& o : r.observations) {
+        const auto it = map->points.find(o.point);
+        if (it == map->points.end() || it->second->bad) continue;
+        obs.push_back({it->second->position, o.uv.cast<double>(), 1.0 / scales[o.octave]});
+      }
+      T_cw = r.reference->poseOf(r.T_c_ref);
+    }
+    if (obs.size() < kMinMatches) continue;
+    std::vector<bool> outlier;
+    const Intrinsics K{camera_->fx(), camera_->fy(), camera_->cx(), camera_->cy()};
+    if (optimizePose(K, obs, T_cw, outlier) < static_cast<int>(kMinMatches)) continue;
+    std::lock_guard lock(map->mutex);
+    r.T_c_ref = r.reference->relative(T_cw);
+    ++refined;
+  }
+  return refined;
 }
 
 void SlamSystem::loadAtlas(const std::vector<std::shared_ptr<Map>>& maps, bool localization_only) {

@@ -32,6 +32,7 @@ struct FrameRecord {
   double tracking_ms = 0;
   int inliers = 0;       // map points tracked
   bool keyframe = false;  // the frame became a keyframe
+  std::vector<FrameObservation> observations;  // its inlier matches (SlamSettings::refine_frames)
 };
 
 class SlamSystem {
@@ -103,6 +104,11 @@ class SlamSystem {
   // Current camera-to-world pose of a tracked frame (through its reference keyframe, so later
   // optimizations of the keyframes move it too).
   Eigen::Isometry3d poseOf(const FrameRecord& r) const;
+  // After finish(): poses every tracked frame again against the final map, by a pose-only
+  // optimization from its own matches (those whose points survive), and keeps the result
+  // relative to its reference keyframe. Frames with too few surviving matches keep their pose.
+  // Returns how many frames were re-posed.
+  int refineFrames();
   // The map holding the most keyframes (the one trajectories are reported in).
   std::shared_ptr<Map> largestMap() const;
 

@@ -107,6 +107,13 @@ TrackingOutput Tracker::track(Frame frame, bool mapping_idle) {
   // Outliers do not go forward to the next frame's matching.
   for (size_t i = 0; i < current.points.size(); ++i)
     if (current.outlier[i]) current.points[i].reset();
+  if (settings_.refine_frames) {
+    out.observations.reserve(static_cast<size_t>(inliers_));
+    for (size_t i = 0; i < current.points.size(); ++i)
+      if (current.points[i] && !current.points[i]->bad)
+        out.observations.push_back({current.points[i]->id, current.frame.points[i].cast<float>(),
+                                    static_cast<uint8_t>(current.frame.keypoints[i].octave)});
+  }
   last_ = std::move(current);
   return out;
 }

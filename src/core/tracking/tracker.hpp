@@ -16,6 +16,13 @@ namespace hiveslam::core {
 
 enum class TrackingState { NotInitialized, Ok, Lost };
 
+// One inlier match of a tracked frame: the map point and where the frame saw it.
+struct FrameObservation {
+  Id point;
+  Eigen::Vector2f uv;  // undistorted pixel
+  uint8_t octave;
+};
+
 struct TrackingOutput {
   TrackingState state = TrackingState::NotInitialized;
   bool tracked = false;
@@ -25,6 +32,8 @@ struct TrackingOutput {
   std::shared_ptr<KeyFrame> new_keyframe;   // for local mapping (also the initial two)
   std::shared_ptr<Map> new_map;             // set when initialization created a map
   int inliers = 0;
+  // The frame's inlier matches: which point each keypoint saw, for SlamSystem::refineFrames.
+  std::vector<FrameObservation> observations;
 };
 
 class Tracker {
