@@ -250,6 +250,7 @@ int SlamSystem::refineFrames() {
   // Below this many surviving matches a pose-only fit is weaker than the tracked pose.
   constexpr size_t kMinMatches = 30;
   const auto& scales = extractor_.scales();
+  const Intrinsics K{camera_->fx(), camera_->fy(), camera_->cx(), camera_->cy()};
   int refined = 0;
   for (auto& r : records_) {
     if (!r.tracked || r.observations.size() < kMinMatches) continue;
@@ -269,7 +270,6 @@ int SlamSystem::refineFrames() {
     }
     if (obs.size() < kMinMatches) continue;
     std::vector<bool> outlier;
-    const Intrinsics K{camera_->fx(), camera_->fy(), camera_->cx(), camera_->cy()};
     if (optimizePose(K, obs, T_cw, outlier) < static_cast<int>(kMinMatches)) continue;
     std::lock_guard lock(map->mutex);
     r.T_c_ref = r.reference->relative(T_cw);
