@@ -55,6 +55,9 @@ void KeyframePublisher::publish(const Job& job) {
   {
     std::lock_guard lock(job.map->mutex);
     const core::KeyFrame& kf = *job.keyframe;
+    // Culled before its turn: its erasure goes out with the map's journal. Sent, it was made
+    // again at the receiver, which would hold it alone.
+    if (kf.bad) return;
     label = label_ ? label_(*job.map) : 0;
     m.keyframe = captureKeyframe(kf, job.map->id, true);
     std::vector<const core::KeyFrame*> with_points{&kf};

@@ -88,6 +88,11 @@ bool Observer::erasedPoint(Id id) const {
   return erased_points_.count(id) > 0;
 }
 
+bool Observer::erasedKeyframe(Id id) const {
+  std::lock_guard lock(mutex_);
+  return erased_keyframes_.count(id) > 0;
+}
+
 void Observer::revive(const MapRecord& snapshot) {
   std::lock_guard lock(mutex_);
   for (const auto& k : snapshot.keyframes) erased_keyframes_.erase(k.id);

@@ -38,6 +38,7 @@ class Observer {
   // Whether the point was erased here (a tombstone: a record from a node that has not heard of
   // the erasure yet must not bring it back).
   bool erasedPoint(Id id) const;
+  bool erasedKeyframe(Id id) const;  // likewise
   // An authoritative snapshot lists these as alive: their tombstones go before it is recorded.
   void revive(const MapRecord& snapshot);
   // A global map's batches from `sender` until the last one is in; returns all batches then.

@@ -201,6 +201,15 @@ StateIntegrator::Added StateIntegrator::addKeyframe(const KeyFrameMessage& m, ui
       out.held = true;
       return out;
     }
+    if (observer_.erasedKeyframe(kf->id)) {
+      // Erased here before its message was taken: culled after a hand-over snapshot brought
+      // it, or its erasure came first on the map topic. It stays erased (made again, it was
+      // alive in this map only); routed marked bad, it is acknowledged, not mapped.
+      kf->bad = true;
+      out.map = map;
+      out.keyframe = kf;
+      return out;
+    }
     if (m.keyframe.made_from != kNoId)
       if (auto it = map->keyframes.find(m.keyframe.made_from); it != map->keyframes.end())
         kf->made_from = it->second.get();

@@ -283,6 +283,35 @@ TEST_F(EpochLabels, AKeyframeThatCameFirstInASnapshotIsStillReturnedForItsModule
   expectPose(*added.keyframe, moved(poseAt(0.4), S));
 }
 
+// A mapping node that just joined got keyframe 13 first in the hand-over snapshot and culled
+// it as its mapping went on; then 13's own message came out of the queue. Made again from the
+// message, it lived on in this node's map alone (erased at every other node and in this
+// node's S_full; TR ended an ASan run a keyframe short). It stays erased: returned marked bad,
+// local mapping acknowledges it to its maker and maps nothing.
+TEST_F(EpochLabels, AKeyframeErasedHereBeforeItsMessageWasTakenStaysErased) {
+  const KeyFrameMessage m = keyframeOnSecond(poseAt(0.4));
+  const auto first = integrator_.addKeyframe(m, 0);
+  ASSERT_TRUE(first.keyframe);
+  {
+    std::lock_guard lock(first.map->mutex);
+    core::insertKeyframe(*first.map, *first.keyframe, slam_.scales(), &slam_.database());
+  }
+  MapRecord culled;
+  culled.map = kMap;
+  culled.erased_keyframes = {13};
+  integrator_.applyLocal(culled);
+  ASSERT_EQ(observer_.digest().keyframes.count(13), 0u);
+
+  const auto again = integrator_.addKeyframe(m, 0);
+  ASSERT_TRUE(again.keyframe) << "nothing returned: local mapping would never acknowledge it";
+  EXPECT_TRUE(again.keyframe->bad);
+  EXPECT_FALSE(again.held);
+  std::lock_guard lock(again.map->mutex);
+  core::insertKeyframe(*again.map, *again.keyframe, slam_.scales(), &slam_.database());
+  EXPECT_EQ(again.map->keyframes.count(13), 0u) << "made again in this node's map";
+  EXPECT_EQ(observer_.digest().keyframes.count(13), 0u);
+}
+
 // A sender many global updates behind (each global map takes a second or more to send, and
 // global BAs follow one another): its label is older than every one this node keeps. It is
 // still from an old frame, and its keyframe is re-posed, not taken as it is.

@@ -4,6 +4,10 @@
 // thing; a tracking node whose local mapping runs on another node does it itself, so that it
 // can track against its own keyframes before the remote map update arrives. The caller holds
 // the map's mutex.
+//
+// A keyframe culled before its turn (one that came in a hand-over snapshot, or was taken back,
+// while its own job still waited in a queue) stays out: put back, it was alive in this node's
+// map only, erased everywhere else and in this node's own S_full.
 #include <vector>
 
 #include "core/map/map.hpp"

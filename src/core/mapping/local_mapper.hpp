@@ -25,7 +25,10 @@ class LocalMapper {
 
   // Runs every step for one keyframe of `map` (the caller holds no lock; each step takes the
   // map's mutex). `abort_ba` lets a newer keyframe cut the local BA short; `before_ba` runs
-  // with no lock held once the keyframe's new points are in the map, before local BA.
+  // with no lock held once the keyframe's new points are in the map, before local BA. A
+  // keyframe culled before its turn (core/mapping/keyframe_insertion.hpp) is not mapped, but
+  // `before_ba` still runs: a distributed node acknowledges the keyframe there, and its maker
+  // waits for that word.
   void process(const std::shared_ptr<Map>& map, const std::shared_ptr<KeyFrame>& kf,
                const std::atomic<bool>* abort_ba = nullptr, const std::function<void()>& before_ba = {});
   const MappingStats& stats() const { return stats_; }
