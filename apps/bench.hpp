@@ -25,5 +25,7 @@ struct BenchRow {
 
 nlohmann::json runBench(const BenchOptions& options);
 std::string benchTable(const nlohmann::json& rows);
+// Which of issue 5's acceptance rules the rows' 1-node and 3-node runs hold; empty without both.
+std::string benchRules(const nlohmann::json& rows);
 
 }  // namespace hiveslam::apps

@@ -1,30 +1,25 @@
 // hiveslam bench SEQUENCE... --out DIR: the paper's protocol. Every sequence in the 1-node and
 // the 3-node configuration (or those given), N repeats each, frames fed at their timestamps;
 // prints the paper's table rows (ATE, fails, CPU at TR, bandwidth TR/LM/LC, keyframe and map
-// message rates) and writes DIR/bench.json.
+// message rates), then which of issue 5's acceptance rules hold (eval/bench_rules), and writes
+// DIR/bench.json (`hiveslam eval bench DIR/bench.json` prints both again).
 #include <fmt/format.h>
 
 #include <algorithm>
 #include <filesystem>
 #include <fstream>
+#include <map>
 
 #include "apps/bench.hpp"
 #include "apps/cluster.hpp"
 #include "apps/commands.hpp"
 #include "common/error.hpp"
+#include "eval/bench_rules.hpp"
+#include "eval/error_stats.hpp"
 
 namespace hiveslam::apps {
 
 namespace {
-
-double median(std::vector<double> v) {
-  if (v.empty()) return 0;
-  std::sort(v.begin(), v.end());
-  const size_t n = v.size();
-  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
-
-double maxOf(const std::vector<double>& v) { return v.empty() ? 0 : *std::max_element(v.begin(), v.end()); }
 
 double mbps(const nlohmann::json& j) { return j.is_object() ? j.value("bandwidth_mbps", 0.0) : 0.0; }
 
@@ -79,20 +74,43 @@ std::string benchTable(const nlohmann::json& rows) {
                               "nodes", "ATE m (med/max)", "ATE %", "fails", "TR CPU s", "TR CPU%", "tracked",
                               "BW TR/LM/LC", "KF/Map Hz", "loops", "maps");
   for (const auto& r : rows) {
-    auto m = [&](const char* k) { return r[k]["median"].get<double>(); };
+    auto m = [&](const char* k) { return r.at(k).at("median").get<double>(); };
     t += fmt::format("{:<12} {:>5} {:>7.4f}/{:<8.4f} {:>8.3f} {:>6.1f} {:>9.1f} {:>7.1f} {:>6.1f}% {:>5.1f}/{:>4.1f}/{:>4.1f} {:>5.1f}/{:<5.1f} {:>5.1f} {:>4.0f}\n",
-                     r["sequence"].get<std::string>(), r["nodes"].get<int>(), m("ate"), r["ate"]["max"].get<double>(),
+                     r.at("sequence").get<std::string>(), r.at("nodes").get<int>(), m("ate"), r.at("ate").at("max").get<double>(),
                      m("ate_percent"), m("fails"), m("cpu_seconds"), m("cpu_percent"), m("tracked"), m("bw_tr"),
-                     m("bw_lm"), m("bw_lc"), m("kf_hz"), m("map_hz"), m("loops"), r["maps"]["max"].get<double>());
+                     m("bw_lm"), m("bw_lc"), m("kf_hz"), m("map_hz"), m("loops"), r.at("maps").at("max").get<double>());
   }
   t += "medians over the runs; BW in Mbps (both directions) at each node; rates of the keyframe and map messages at TR;\n"
        "maps: the most maps TR ended a run with (more than 1: a merge did not reach it, and ATE covers the largest only)\n";
   return t;
 }
 
+std::string benchRules(const nlohmann::json& rows) {
+  std::map<std::string, eval::SequenceRuns> by_name;
+  std::vector<std::string> order;
+  for (const auto& r : rows) {
+    const auto name = r.at("sequence").get<std::string>();
+    const int nodes = r.at("nodes").get<int>();
+    if (nodes != 1 && nodes != 3) continue;
+    if (!by_name.count(name)) order.push_back(name);
+    auto& s = by_name[name];
+    s.sequence = name;
+    auto& c = nodes == 1 ? s.one_node : s.three_nodes;
+    c.ate_m = r.at("ate").at("runs").get<std::vector<double>>();
+    c.tr_cpu_seconds = r.at("cpu_seconds").at("runs").get<std::vector<double>>();
+    c.tr_mbps = r.at("bw_tr").at("runs").get<std::vector<double>>();
+  }
+  std::vector<eval::SequenceRuns> sequences;
+  for (const auto& n : order) sequences.push_back(by_name[n]);
+  const auto checks = eval::checkBenchRules(sequences);
+  if (checks.empty()) return "";
+  return "acceptance (issue 5), from the runs above:\n" + eval::ruleTable(checks);
+}
+
 nlohmann::json BenchRow::toJson() const {
   auto stat = [](const std::vector<double>& v) {
-    return nlohmann::json{{"median", median(v)}, {"max", maxOf(v)}, {"runs", v}};
+    const auto s = eval::summarize(v);
+    return nlohmann::json{{"median", s.median}, {"max", s.max}, {"runs", v}};
   };
   return {{"sequence", sequence}, {"nodes", nodes},        {"ate", stat(ate)},
           {"ate_percent", stat(ate_percent)}, {"fails", stat(fails)}, {"tracked", stat(tracked)},
@@ -113,7 +131,8 @@ void addBenchCommand(CLI::App& app) {
   cmd->add_flag("--feed-topic", o->feed_topic, "Play each dataset as a ROS 2 image topic to TR (the paper's set-up)");
   cmd->callback([o]() {
     if (o->repeats < 1) throw InputError("--repeats must be at least 1");
-    fmt::print("{}", benchTable(runBench(*o)));
+    const auto rows = runBench(*o);
+    fmt::print("{}{}", benchTable(rows), benchRules(rows));
   });
 }
 

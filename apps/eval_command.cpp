@@ -1,10 +1,14 @@
 // hiveslam eval ate|rpe GT EST: trajectory errors with evo's rules, as a table or JSON.
 // hiveslam eval scale-step GT EST and scale-precision ATLAS: a monocular run's scale step
 // between two stretches, and how precisely the map's own measurements could fix it.
+// hiveslam eval bench DIR/bench.json: a saved bench's table and acceptance rules, again.
 #include <fmt/format.h>
 
 #include <nlohmann/json.hpp>
 
+#include <fstream>
+
+#include "apps/bench.hpp"
 #include "apps/commands.hpp"
 #include "common/error.hpp"
 #include "eval/scale_precision.hpp"
@@ -179,6 +183,21 @@ void addEvalCommand(CLI::App& app) {
     fmt::print("residual noise {:.3f} sigma per coordinate; {} trials at {:.3f} sigma\n", r.residual_noise, r.steps.size(),
                r.noise);
     fmt::print("scale step: mean {:.4f}, sd {:.4f} ({:.2f}%)\n", r.mean, r.sd, 100.0 * r.sd);
+  });
+
+  auto bench_file = std::make_shared<std::string>();
+  auto* bench_cmd = eval->add_subcommand("bench", "A saved bench's table and acceptance rules (DIR/bench.json)");
+  bench_cmd->add_option("BENCH_JSON", *bench_file, "bench.json written by hiveslam bench")->required();
+  bench_cmd->callback([bench_file]() {
+    std::ifstream in(*bench_file);
+    if (!in) throw InputError("cannot open " + *bench_file);
+    const auto rows = nlohmann::json::parse(in, nullptr, false);
+    if (rows.is_discarded() || !rows.is_array()) throw InputError(*bench_file + " is not a bench.json (a JSON array of rows)");
+    try {
+      fmt::print("{}{}", benchTable(rows), benchRules(rows));
+    } catch (const nlohmann::json::exception& e) {
+      throw InputError(*bench_file + ": a row lacks what hiveslam bench writes (" + e.what() + ")");
+    }
   });
 }
 

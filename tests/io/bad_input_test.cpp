@@ -150,19 +150,36 @@ TEST(BadInput, EurocSensorYamlWithWrongResolution) {
   EXPECT_NE(errorOf([&] { openDataset(dir.path()); }).find("sensor.yaml"), std::string::npos);
 }
 
-// The command line turns every one of these into one line on stderr and a non-zero exit.
-TEST(BadInput, CommandLinePrintsOneLineAndFails) {
-  const std::string cmd = std::string(HIVESLAM_BINARY) + " info /nonexistent/hiveslam/dataset 2>&1";
+// Runs `hiveslam ARGS` and checks that it failed with exactly one line of output containing
+// `expected`.
+void expectOneLineFailure(const std::string& args, const std::string& expected) {
+  const std::string cmd = std::string(HIVESLAM_BINARY) + " " + args + " 2>&1";
   FILE* pipe = popen(cmd.c_str(), "r");
   ASSERT_NE(pipe, nullptr);
   std::string out;
   std::array<char, 256> buf{};
   while (fgets(buf.data(), buf.size(), pipe)) out += buf.data();
   const int status = pclose(pipe);
-  EXPECT_TRUE(WIFEXITED(status));
-  EXPECT_NE(WEXITSTATUS(status), 0);
+  EXPECT_TRUE(WIFEXITED(status)) << args;
+  EXPECT_NE(WEXITSTATUS(status), 0) << args;
   EXPECT_EQ(std::count(out.begin(), out.end(), '\n'), 1) << out;
-  EXPECT_NE(out.find("dataset not found: /nonexistent/hiveslam/dataset"), std::string::npos) << out;
+  EXPECT_NE(out.find(expected), std::string::npos) << out;
+}
+
+// The command line turns every one of these into one line on stderr and a non-zero exit.
+TEST(BadInput, CommandLinePrintsOneLineAndFails) {
+  expectOneLineFailure("info /nonexistent/hiveslam/dataset", "dataset not found: /nonexistent/hiveslam/dataset");
+}
+
+TEST(BadInput, ASavedBenchIsCheckedBeforeItIsRead) {
+  testing::TempDir dir;
+  expectOneLineFailure("eval bench " + (dir / "missing.json").string(), "cannot open");
+  std::ofstream(dir / "object.json") << "{\"sequence\": \"sweep\"}";
+  expectOneLineFailure("eval bench " + (dir / "object.json").string(), "is not a bench.json");
+  std::ofstream(dir / "truncated.json") << "[{\"sequence\": \"sweep\", \"nodes\": ";
+  expectOneLineFailure("eval bench " + (dir / "truncated.json").string(), "is not a bench.json");
+  std::ofstream(dir / "short_row.json") << "[{\"sequence\": \"sweep\", \"nodes\": 1}]";
+  expectOneLineFailure("eval bench " + (dir / "short_row.json").string(), "a row lacks what hiveslam bench writes");
 }
 
 TEST(BadInput, DistributionSettingsAreReadAndChecked) {
