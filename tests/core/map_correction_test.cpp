@@ -7,6 +7,7 @@
 #include <cmath>
 
 #include "core/loop/map_correction.hpp"
+#include "core/slot_frame.hpp"
 
 namespace hiveslam::core {
 namespace {
@@ -25,10 +26,7 @@ struct Corridor {
       map.add(points.back());
     }
     for (int k = 0; k < 6; ++k) {
-      Frame f;
-      f.keypoints.resize(points.size());
-      f.points.resize(points.size(), Eigen::Vector2d::Zero());
-      f.descriptors = cv::Mat::zeros(static_cast<int>(points.size()), 32, CV_8U);
+      const Frame f = testing::slotFrame(points.size());
       Eigen::Isometry3d T_cw = Eigen::Isometry3d::Identity();
       T_cw.translation() = -Eigen::Vector3d(0.3 * k, 0, 0);
       auto kf = std::make_shared<KeyFrame>(static_cast<Id>(k + 1), f, T_cw);
