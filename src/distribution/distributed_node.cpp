@@ -540,6 +540,20 @@ nlohmann::json DistributedNode::report(double seconds) const {
     j["peers"] = peers_.size();
   }
   j["s_full_keyframes"] = observer_.keyframeCount();
+  {
+    const auto digest = observer_.digest();
+    std::vector<core::Id> missing;
+    for (const auto& [id, pose] : digest.keyframes) {
+      bool found = false;
+      for (const auto& map : slam_.liveMaps()) {
+        std::lock_guard lock(map->mutex);
+        if (map->keyframes.count(id)) found = true;
+      }
+      if (!found) missing.push_back(id);
+    }
+    std::sort(missing.begin(), missing.end());
+    j["s_full_keyframes_not_in_map"] = missing;
+  }
   return j;
 }
 

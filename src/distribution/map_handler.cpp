@@ -362,6 +362,7 @@ void MapHandler::captureGlobal(GlobalJob& g) {
   base.map = map.id;
   base.epoch = g.epoch;
   base.merged_maps = g.merged;
+  base.update = ++updates_captured_;
   {
     std::lock_guard lock(map.mutex);
     base.origin = map.origin ? map.origin->id : kNoId;
@@ -387,6 +388,7 @@ void MapHandler::captureGlobal(GlobalJob& g) {
     m.kind = base.kind;
     m.map = base.map;
     m.epoch = base.epoch;
+    m.update = base.update;
     m.origin = base.origin;
     m.merged_maps = base.merged_maps;
     if (b == 0) {  // erasures once

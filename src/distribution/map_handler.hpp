@@ -123,6 +123,7 @@ class MapHandler {
   std::thread thread_;
   // Handler thread only: hash of the links last sent per (topic, keyframe).
   std::unordered_map<core::Id, size_t> links_sent_[communication::kTopicCount];
+  uint32_t updates_captured_ = 0;  // handler thread only: numbers this node's global maps
   std::atomic<int> local_sent_{0}, global_sent_{0}, received_{0}, dropped_{0};
 };
 

@@ -110,7 +110,11 @@ std::optional<std::vector<MapRecord>> Observer::collectGlobal(MapRecord&& batch,
   std::lock_guard lock(mutex_);
   const std::pair<Id, uint16_t> key{batch.map, sender};
   auto& pending = pending_global_[key];
-  if (!pending.empty() && (pending.front().epoch != batch.epoch || pending.front().batches != batch.batches)) {
+  // A sender's batches arrive in the order it sent them, one global map after the other: a
+  // batch of another update means the one pending was cut short (or began before this node
+  // listened).
+  if (!pending.empty() && (pending.front().epoch != batch.epoch || pending.front().update != batch.update ||
+                           pending.front().batches != batch.batches)) {
     if (pending.front().epoch > batch.epoch) return std::nullopt;  // a late batch of an older update
     pending.clear();
   }

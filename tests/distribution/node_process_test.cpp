@@ -47,6 +47,13 @@ nlohmann::json report(const fs::path& file) {
 
 std::vector<std::string> tasks(const nlohmann::json& r) { return r.value("tasks", std::vector<std::string>{}); }
 
+// Every keyframe of a node's S_full is in its SLAM map too: a keyframe known only by its record
+// (its features never came) cannot be tracked against, matched or corrected there.
+void expectSFullInMap(const nlohmann::json& r, const std::string& node) {
+  ASSERT_TRUE(r.contains("s_full_keyframes_not_in_map")) << node;
+  EXPECT_TRUE(r["s_full_keyframes_not_in_map"].empty()) << node << ": " << r["s_full_keyframes_not_in_map"].dump();
+}
+
 TEST(NodeProcesses, ThreeNodesOverLoopback) {
   testing::TempDir out;
   const std::string cmd = std::string(HIVESLAM_BINARY) + " cluster --nodes 3 " + sequence().string() + " --out " +
@@ -70,6 +77,9 @@ TEST(NodeProcesses, ThreeNodesOverLoopback) {
   // The same keyframes in S_full everywhere after the end-of-run exchange.
   EXPECT_EQ(tr.value("s_full_keyframes", 0), lm.value("s_full_keyframes", -1));
   EXPECT_EQ(lc.value("s_full_keyframes", 0), lm.value("s_full_keyframes", -1));
+  expectSFullInMap(tr, "tr");
+  expectSFullInMap(lm, "lm");
+  expectSFullInMap(lc, "lc");
 }
 
 TEST(NodeProcesses, OneNodeIsTheStandaloneSystem) {
@@ -179,6 +189,51 @@ TEST(NodeProcesses, ARestartedMappingNodeTakesTheMapOverFromTracking) {
   EXPECT_EQ(lc.value("map_points", -1), tr.value("map_points", -2));
   EXPECT_EQ(tr.value("s_full_keyframes", 0), lm2.value("s_full_keyframes", -1));
   EXPECT_EQ(lc.value("s_full_keyframes", 0), lm2.value("s_full_keyframes", -1));
+  expectSFullInMap(tr, "tr");
+  expectSFullInMap(lm2, "lm2");
+  expectSFullInMap(lc, "lc");
+  EXPECT_LT(tr["ate"]["percent_of_path"].get<double>(), 1.0);
+}
+
+// The loop-closing node dies at 20% of the frames and is started again at 50%: the gateway
+// (LM) closes loops itself meanwhile, then hands the newcomer the map with every keyframe's
+// features and gives loop closing back. The newcomer must end the run holding the whole map
+// in its SLAM map, not only in S_full: it once joined while LM was sending a global map of
+// the same epoch label, took that map's last batch as its snapshot's and never made the
+// snapshot's last keyframes (observer_test has the mechanism).
+TEST(NodeProcesses, ARestartedLoopClosingNodeTakesTheWholeMapFromTheGateway) {
+  testing::TempDir out;
+  const std::string bin = HIVESLAM_BINARY, domain = " --domain " + std::to_string(50 + getpid() % 50);
+  const std::string tr_log = (out / "tr.log").string();
+  auto reached = [&](int frame) {
+    return "while kill -0 $tr && ! grep -q \"tracking " + std::to_string(frame) + "/240\" " + tr_log + "; do sleep 0.05; done; ";
+  };
+  const std::string run =
+      bin + " node --task lm" + domain + " --out " + (out / "lm").string() + " > " + (out / "lm.log").string() +
+      " 2>&1 & lm=$!; " + bin + " node --task lc" + domain + " --out " + (out / "lc").string() + " > " +
+      (out / "lc.log").string() + " 2>&1 & lc=$!; " + bin + " node --task tr " + sequence().string() + domain +
+      " --expect lm,lc" + kRealtime + " --out " + (out / "tr").string() + " > " + tr_log + " 2>&1 & tr=$!; " + reached(48) +
+      "kill -9 $lc; " + reached(120) + bin + " node --task lc" + domain + " --out " + (out / "lc2").string() +
+      " > " + (out / "lc2.log").string() + " 2>&1 & lc2=$!; wait $tr; status=$?; " +
+      "for i in $(seq 600); do kill -0 $lm 2>/dev/null || break; sleep 0.1; done; " +
+      "for i in $(seq 300); do kill -0 $lc2 2>/dev/null || break; sleep 0.1; done; kill $lm $lc2 2>/dev/null; wait; exit $status";
+  const int status = std::system(("timeout 300 bash -c '" + run + "'").c_str());
+  ASSERT_EQ(status, 0) << std::ifstream(tr_log).rdbuf();
+  const auto tr = report(out / "tr" / "report.json"), lm = report(out / "lm" / "report.json"),
+             lc2 = report(out / "lc2" / "report.json");
+  EXPECT_EQ(tasks(tr), std::vector<std::string>{"tr"}) << tr.dump();
+  EXPECT_EQ(tasks(lm), std::vector<std::string>{"lm"}) << std::ifstream(out / "lm.log").rdbuf();
+  EXPECT_EQ(lm.value("end_of_run", ""), "completed");
+  EXPECT_EQ(lc2.value("end_of_run", ""), "completed") << std::ifstream(out / "lc2.log").rdbuf();
+  // The newcomer holds the whole map in its SLAM map and in S_full, as TR and LM do.
+  EXPECT_EQ(lc2.value("keyframes", -1), tr.value("keyframes", -2));
+  EXPECT_EQ(lc2.value("map_points", -1), tr.value("map_points", -2));
+  EXPECT_EQ(lm.value("keyframes", -1), tr.value("keyframes", -2));
+  EXPECT_EQ(tr.value("s_full_keyframes", 0), lm.value("s_full_keyframes", -1));
+  EXPECT_EQ(lc2.value("s_full_keyframes", 0), lm.value("s_full_keyframes", -1));
+  expectSFullInMap(tr, "tr");
+  expectSFullInMap(lm, "lm");
+  expectSFullInMap(lc2, "lc2");
   EXPECT_LT(tr["ate"]["percent_of_path"].get<double>(), 1.0);
 }
 

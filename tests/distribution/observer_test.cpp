@@ -9,13 +9,14 @@
 namespace hiveslam::distribution {
 namespace {
 
-MapRecord batch(uint64_t epoch, uint32_t i, uint32_t n) {
+MapRecord batch(uint64_t epoch, uint32_t i, uint32_t n, uint32_t update = 0) {
   MapRecord m;
   m.kind = MapRecord::Kind::Global;
   m.map = 7;
   m.epoch = epoch;
   m.batch = i;
   m.batches = n;
+  m.update = update;
   return m;
 }
 
@@ -39,6 +40,32 @@ TEST(ObserverGlobals, ANewerUpdateFromTheSameSenderDropsAnUnfinishedOlderOne) {
   const auto all = o.collectGlobal(batch(2, 1, 2), 3);
   ASSERT_TRUE(all);
   EXPECT_EQ(all->front().epoch, 2u);
+}
+
+// A loop-closing node that returns joins while the gateway, which closed loops in its absence,
+// sends a periodic global map; the newcomer's snapshot follows with the same epoch label and
+// the same number of batches. Collected by label, the first map's last batch completed the
+// snapshot in its place: the returning node never made the snapshot's last keyframes and ended
+// the run without them (session 27, 3 of 11 runs).
+TEST(ObserverGlobals, TwoUpdatesWithOneLabelAreCollectedApart) {
+  Observer o;
+  constexpr uint16_t kLm = 2;
+  auto snapshot = [](uint32_t i) {
+    MapRecord m = batch(8, i, 3, /*update=*/6);
+    m.keyframes.emplace_back().full = true;
+    return m;
+  };
+  EXPECT_FALSE(o.collectGlobal(batch(8, 2, 3, /*update=*/5), kLm));  // the periodic map's last batch
+  EXPECT_FALSE(o.collectGlobal(snapshot(0), kLm));
+  EXPECT_FALSE(o.collectGlobal(snapshot(1), kLm));
+  const auto all = o.collectGlobal(snapshot(2), kLm);
+  ASSERT_TRUE(all);
+  ASSERT_EQ(all->size(), 3u);
+  for (const auto& b : *all) {
+    EXPECT_EQ(b.update, 6u);
+    ASSERT_EQ(b.keyframes.size(), 1u);
+    EXPECT_TRUE(b.keyframes.front().full);
+  }
 }
 
 }  // namespace

@@ -59,6 +59,7 @@ TEST(Wire, MapRoundTripWithoutUnchangedLinks) {
   m.epoch = 3;
   m.batch = 1;
   m.batches = 2;
+  m.update = 41;
   KeyFrameRecord k;
   k.id = 5;
   k.links = false;
@@ -69,6 +70,7 @@ TEST(Wire, MapRoundTripWithoutUnchangedLinks) {
   const auto back = decodeMap(unpack(pack(m, 1, 0, 7, 3), PacketKind::Map));
   EXPECT_EQ(back.kind, MapRecord::Kind::Global);
   EXPECT_EQ(back.batch, 1u);
+  EXPECT_EQ(back.update, 41u);
   EXPECT_FALSE(back.keyframes.at(0).links);
   EXPECT_EQ(back.erased_points, m.erased_points);
   EXPECT_EQ(back.replaced_points, m.replaced_points);

@@ -210,6 +210,7 @@ std::vector<uint8_t> encode(const MapRecord& m) {
   w.put(m.epoch);
   w.put(m.batch);
   w.put(m.batches);
+  w.put(m.update);
   w.put(m.origin);
   w.put(static_cast<uint32_t>(m.keyframes.size()));
   for (const auto& k : m.keyframes) putKeyframe(w, k);
@@ -239,6 +240,7 @@ MapRecord decodeMap(const std::vector<uint8_t>& raw) {
   m.batch = r.get<uint32_t>();
   m.batches = r.get<uint32_t>();
   if (m.batches == 0 || m.batch >= m.batches || m.batches > 100000) throw WireError("bad batch numbers");
+  m.update = r.get<uint32_t>();
   m.origin = r.get<Id>();
   m.keyframes.resize(r.count(57));
   for (auto& k : m.keyframes) k = getKeyframe(r);

@@ -52,6 +52,10 @@ struct MapRecord {
   Id map = kNoId;
   uint64_t epoch = 0;
   uint32_t batch = 0, batches = 1;
+  // Which of its sender's global maps this batch belongs to, numbered as the sender captures
+  // them. Two global maps can carry one epoch label (a newcomer's snapshot right after the
+  // periodic global map it joined during), and their batches must not be collected as one.
+  uint32_t update = 0;
   Id origin = kNoId;
   std::vector<KeyFrameRecord> keyframes;
   std::vector<PointRecord> points;
