@@ -15,6 +15,7 @@
 #include <fastdds/dds/topic/Topic.hpp>
 #include <fastdds/dds/topic/TypeSupport.hpp>
 #include <fastdds/rtps/common/InstanceHandle.h>
+#include <fastdds/rtps/transport/UDPv4TransportDescriptor.h>
 
 #include <array>
 #include <atomic>
@@ -243,6 +244,14 @@ void DdsTransport::start(const PeerInfo& self, PeerHandler on_peer) {
   discovery.leaseDuration_announcementperiod = Duration_t(0, 500'000'000);
   discovery.initial_announcements.count = 5;
   discovery.initial_announcements.period = Duration_t(0, 100'000'000);
+  // UDP only, no shared memory. A node killed and started again on the same host can take its
+  // old participant's shared-memory port; Fast DDS 2.9 then removes the dead port's segment
+  // while the peers still write into it, and neither side ever matches the other (session 27:
+  // a returning LC saw no peer for 24 s, 1 restart in about 30; upstream eProsima/Fast-DDS
+  // PR 4728, after 2.9). Nodes on separate devices talk UDP anyway, and a node sends a few
+  // Mbps at most.
+  pq.transport().use_builtin_transports = false;
+  pq.transport().user_transports.push_back(std::make_shared<eprosima::fastdds::rtps::UDPv4TransportDescriptor>());
   d.participant = dds::DomainParticipantFactory::get_instance()->create_participant(
       static_cast<dds::DomainId_t>(d.options.domain), pq, &d, dds::StatusMask::none());
   if (!d.participant) throw InputError("DDS: cannot create a participant on domain " + std::to_string(d.options.domain));
