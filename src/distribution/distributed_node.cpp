@@ -2,7 +2,9 @@
 
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
 #include <chrono>
+#include <unordered_set>
 
 #include "core/mapping/keyframe_insertion.hpp"
 #include "distribution/packet.hpp"
@@ -540,21 +542,21 @@ nlohmann::json DistributedNode::report(double seconds) const {
     j["peers"] = peers_.size();
   }
   j["s_full_keyframes"] = observer_.keyframeCount();
-  {
-    const auto digest = observer_.digest();
-    std::vector<core::Id> missing;
-    for (const auto& [id, pose] : digest.keyframes) {
-      bool found = false;
-      for (const auto& map : slam_.liveMaps()) {
-        std::lock_guard lock(map->mutex);
-        if (map->keyframes.count(id)) found = true;
-      }
-      if (!found) missing.push_back(id);
-    }
-    std::sort(missing.begin(), missing.end());
-    j["s_full_keyframes_not_in_map"] = missing;
-  }
+  j["s_full_keyframes_not_in_map"] = sFullKeyframesNotInMap();
   return j;
+}
+
+std::vector<core::Id> DistributedNode::sFullKeyframesNotInMap() const {
+  std::unordered_set<core::Id> held;
+  for (const auto& map : slam_.liveMaps()) {
+    std::lock_guard lock(map->mutex);
+    for (const auto& [id, kf] : map->keyframes) held.insert(id);
+  }
+  std::vector<core::Id> missing;
+  for (const auto& [id, pose] : observer_.digest().keyframes)
+    if (!held.count(id)) missing.push_back(id);
+  std::sort(missing.begin(), missing.end());
+  return missing;
 }
 
 }  // namespace hiveslam::distribution

@@ -20,6 +20,7 @@
 #include <mutex>
 #include <nlohmann/json.hpp>
 #include <thread>
+#include <vector>
 
 #include "communication/transport.hpp"
 #include "core/system/slam_system.hpp"
@@ -58,6 +59,9 @@ class DistributedNode final : public core::SystemEvents {
   const Observer& observer() const { return observer_; }
   // What the node adds to `hiveslam run`'s report: tasks, traffic, message rates.
   nlohmann::json report(double seconds) const;
+  // Keyframes of S_full that no live SLAM map holds: known here by their record only, without
+  // the features to track against, match or correct them. Empty after a healthy run.
+  std::vector<core::Id> sFullKeyframesNotInMap() const;
 
   // core::SystemEvents
   void mapCreated(const std::shared_ptr<core::Map>& map) override;

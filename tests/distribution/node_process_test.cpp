@@ -54,6 +54,20 @@ void expectSFullInMap(const nlohmann::json& r, const std::string& node) {
   EXPECT_TRUE(r["s_full_keyframes_not_in_map"].empty()) << node << ": " << r["s_full_keyframes_not_in_map"].dump();
 }
 
+// After a run the three nodes hold one map: the same keyframes and points in their SLAM maps,
+// the same keyframes in S_full, and nothing in S_full that their SLAM map lacks.
+void expectOneMap(const nlohmann::json& tr, const nlohmann::json& lm, const nlohmann::json& lc) {
+  for (const auto* r : {&lm, &lc}) {
+    EXPECT_EQ(r->value("keyframes", -1), tr.value("keyframes", -2)) << r->value("task", "");
+    EXPECT_EQ(r->value("map_points", -1), tr.value("map_points", -2)) << r->value("task", "");
+    EXPECT_EQ(r->value("s_full_keyframes", -1), tr.value("s_full_keyframes", -2)) << r->value("task", "");
+  }
+  expectSFullInMap(tr, "tr");
+  expectSFullInMap(lm, "lm");
+  expectSFullInMap(lc, "lc");
+  EXPECT_LT(tr["ate"]["percent_of_path"].get<double>(), 1.0);
+}
+
 TEST(NodeProcesses, ThreeNodesOverLoopback) {
   testing::TempDir out;
   const std::string cmd = std::string(HIVESLAM_BINARY) + " cluster --nodes 3 " + sequence().string() + " --out " +
@@ -155,6 +169,32 @@ TEST(NodeProcesses, TrackingTakesMappingBackWhenTheMappingNodeDies) {
   EXPECT_GT(tr["mapping"]["keyframes_processed"].get<int>(), 0);  // it mapped after the LM left
 }
 
+// LM, LC and TR as processes on `domain`, TR on the test sequence in real time. The node of
+// `task` (lm or lc) is killed with kill -9 when TR reaches frame 48 of 240 and started again
+// at frame 120, with its old id and nothing held, writing to <out>/<task>2. After TR's end the
+// others get a minute each to finish, then they are stopped. Returns TR's exit status.
+int runWithARestart(const fs::path& out, const std::string& task, int domain) {
+  const std::string bin = HIVESLAM_BINARY, d = " --domain " + std::to_string(domain);
+  const std::string tr_log = (out / "tr.log").string();
+  auto reached = [&](int frame) {
+    return "while kill -0 $tr && ! grep -q \"tracking " + std::to_string(frame) + "/240\" " + tr_log + "; do sleep 0.05; done; ";
+  };
+  auto start = [&](const std::string& t, const std::string& name) {
+    return bin + " node --task " + t + d + " --out " + (out / name).string() + " > " + (out / (name + ".log")).string() +
+           " 2>&1 & " + name + "=$!; ";
+  };
+  auto await = [](const std::string& name) {
+    return "for i in $(seq 600); do kill -0 $" + name + " 2>/dev/null || break; sleep 0.1; done; ";
+  };
+  const std::string other = task == "lm" ? "lc" : "lm";
+  const std::string run = start("lm", "lm") + start("lc", "lc") + bin + " node --task tr " + sequence().string() + d +
+                          " --expect lm,lc" + kRealtime + " --out " + (out / "tr").string() + " > " + tr_log +
+                          " 2>&1 & tr=$!; " + reached(48) + "kill -9 $" + task + "; " + reached(120) +
+                          start(task, task + "2") + "wait $tr; status=$?; " + await(task + "2") + await(other) +
+                          "kill $" + task + "2 $" + other + " 2>/dev/null; wait; exit $status";
+  return std::system(("timeout 300 bash -c '" + run + "'").c_str());
+}
+
 // The mapping node dies at 20% of the frames and is started again at 50%, as it was (the same
 // id, nothing held): TR notices the death after the 2 s lease, maps alone, then hands the
 // newcomer the map it kept over DDS once the newcomer's readers have matched, and gives
@@ -162,21 +202,8 @@ TEST(NodeProcesses, TrackingTakesMappingBackWhenTheMappingNodeDies) {
 // keyframes for good: it gets a minute after TR's end, then it is stopped.)
 TEST(NodeProcesses, ARestartedMappingNodeTakesTheMapOverFromTracking) {
   testing::TempDir out;
-  const std::string bin = HIVESLAM_BINARY, domain = " --domain " + std::to_string(200 + getpid() % 30);
-  const std::string tr_log = (out / "tr.log").string();
-  auto reached = [&](int frame) {
-    return "while kill -0 $tr && ! grep -q \"tracking " + std::to_string(frame) + "/240\" " + tr_log + "; do sleep 0.05; done; ";
-  };
-  const std::string run =
-      bin + " node --task lm" + domain + " --out " + (out / "lm").string() + " > " + (out / "lm.log").string() +
-      " 2>&1 & lm=$!; " + bin + " node --task lc" + domain + " --out " + (out / "lc").string() + " > " +
-      (out / "lc.log").string() + " 2>&1 & lc=$!; " + bin + " node --task tr " + sequence().string() + domain +
-      " --expect lm,lc" + kRealtime + " --out " + (out / "tr").string() + " > " + tr_log + " 2>&1 & tr=$!; " + reached(48) +
-      "kill -9 $lm; " + reached(120) + bin + " node --task lm" + domain + " --out " + (out / "lm2").string() +
-      " > " + (out / "lm2.log").string() + " 2>&1 & lm2=$!; wait $tr; status=$?; " +
-      "for i in $(seq 600); do kill -0 $lm2 2>/dev/null || break; sleep 0.1; done; kill $lm2 $lc 2>/dev/null; wait; exit $status";
-  const int status = std::system(("timeout 300 bash -c '" + run + "'").c_str());
-  ASSERT_EQ(status, 0) << std::ifstream(tr_log).rdbuf();
+  const int status = runWithARestart(out.path(), "lm", 200 + getpid() % 30);
+  ASSERT_EQ(status, 0) << std::ifstream(out / "tr.log").rdbuf();
   const auto tr = report(out / "tr" / "report.json"), lm2 = report(out / "lm2" / "report.json"),
              lc = report(out / "lc" / "report.json");
   EXPECT_EQ(tasks(tr), std::vector<std::string>{"tr"}) << tr.dump();
@@ -184,15 +211,7 @@ TEST(NodeProcesses, ARestartedMappingNodeTakesTheMapOverFromTracking) {
   EXPECT_GT(tr["mapping"]["keyframes_processed"].get<int>(), 0);   // TR mapped during the outage
   EXPECT_GT(lm2["mapping"]["keyframes_processed"].get<int>(), 0);  // and the newcomer after it
   // The newcomer holds the whole map, not only what it mapped itself.
-  EXPECT_EQ(lm2.value("keyframes", -1), tr.value("keyframes", -2));
-  EXPECT_EQ(lm2.value("map_points", -1), tr.value("map_points", -2));
-  EXPECT_EQ(lc.value("map_points", -1), tr.value("map_points", -2));
-  EXPECT_EQ(tr.value("s_full_keyframes", 0), lm2.value("s_full_keyframes", -1));
-  EXPECT_EQ(lc.value("s_full_keyframes", 0), lm2.value("s_full_keyframes", -1));
-  expectSFullInMap(tr, "tr");
-  expectSFullInMap(lm2, "lm2");
-  expectSFullInMap(lc, "lc");
-  EXPECT_LT(tr["ate"]["percent_of_path"].get<double>(), 1.0);
+  expectOneMap(tr, lm2, lc);
 }
 
 // The loop-closing node dies at 20% of the frames and is started again at 50%: the gateway
@@ -203,22 +222,8 @@ TEST(NodeProcesses, ARestartedMappingNodeTakesTheMapOverFromTracking) {
 // snapshot's last keyframes (observer_test has the mechanism).
 TEST(NodeProcesses, ARestartedLoopClosingNodeTakesTheWholeMapFromTheGateway) {
   testing::TempDir out;
-  const std::string bin = HIVESLAM_BINARY, domain = " --domain " + std::to_string(50 + getpid() % 50);
-  const std::string tr_log = (out / "tr.log").string();
-  auto reached = [&](int frame) {
-    return "while kill -0 $tr && ! grep -q \"tracking " + std::to_string(frame) + "/240\" " + tr_log + "; do sleep 0.05; done; ";
-  };
-  const std::string run =
-      bin + " node --task lm" + domain + " --out " + (out / "lm").string() + " > " + (out / "lm.log").string() +
-      " 2>&1 & lm=$!; " + bin + " node --task lc" + domain + " --out " + (out / "lc").string() + " > " +
-      (out / "lc.log").string() + " 2>&1 & lc=$!; " + bin + " node --task tr " + sequence().string() + domain +
-      " --expect lm,lc" + kRealtime + " --out " + (out / "tr").string() + " > " + tr_log + " 2>&1 & tr=$!; " + reached(48) +
-      "kill -9 $lc; " + reached(120) + bin + " node --task lc" + domain + " --out " + (out / "lc2").string() +
-      " > " + (out / "lc2.log").string() + " 2>&1 & lc2=$!; wait $tr; status=$?; " +
-      "for i in $(seq 600); do kill -0 $lm 2>/dev/null || break; sleep 0.1; done; " +
-      "for i in $(seq 300); do kill -0 $lc2 2>/dev/null || break; sleep 0.1; done; kill $lm $lc2 2>/dev/null; wait; exit $status";
-  const int status = std::system(("timeout 300 bash -c '" + run + "'").c_str());
-  ASSERT_EQ(status, 0) << std::ifstream(tr_log).rdbuf();
+  const int status = runWithARestart(out.path(), "lc", 50 + getpid() % 50);
+  ASSERT_EQ(status, 0) << std::ifstream(out / "tr.log").rdbuf();
   const auto tr = report(out / "tr" / "report.json"), lm = report(out / "lm" / "report.json"),
              lc2 = report(out / "lc2" / "report.json");
   EXPECT_EQ(tasks(tr), std::vector<std::string>{"tr"}) << tr.dump();
@@ -226,15 +231,7 @@ TEST(NodeProcesses, ARestartedLoopClosingNodeTakesTheWholeMapFromTheGateway) {
   EXPECT_EQ(lm.value("end_of_run", ""), "completed");
   EXPECT_EQ(lc2.value("end_of_run", ""), "completed") << std::ifstream(out / "lc2.log").rdbuf();
   // The newcomer holds the whole map in its SLAM map and in S_full, as TR and LM do.
-  EXPECT_EQ(lc2.value("keyframes", -1), tr.value("keyframes", -2));
-  EXPECT_EQ(lc2.value("map_points", -1), tr.value("map_points", -2));
-  EXPECT_EQ(lm.value("keyframes", -1), tr.value("keyframes", -2));
-  EXPECT_EQ(tr.value("s_full_keyframes", 0), lm.value("s_full_keyframes", -1));
-  EXPECT_EQ(lc2.value("s_full_keyframes", 0), lm.value("s_full_keyframes", -1));
-  expectSFullInMap(tr, "tr");
-  expectSFullInMap(lm, "lm");
-  expectSFullInMap(lc2, "lc2");
-  EXPECT_LT(tr["ate"]["percent_of_path"].get<double>(), 1.0);
+  expectOneMap(tr, lm, lc2);
 }
 
 TEST(NodeProcesses, ThreeNodesInThreeNetworkNamespaces) {

@@ -15,7 +15,9 @@ enum class Control : uint8_t {
   EndOfSequence = 1,  // TR -> LM -> LC: no keyframe after this one
   Done = 2,           // LC -> LM, then LM -> all: everything is sent; LM's last snapshot precedes it
 };
-constexpr uint16_t kWireVersion = 1;
+// Raised with every change of the encoding, so that a node of another build drops what it
+// cannot read with a warning instead of misreading it. 2: map records carry `update`.
+constexpr uint16_t kWireVersion = 2;
 
 std::vector<uint8_t> encode(const KeyFrameMessage& m);
 std::vector<uint8_t> encode(const MapRecord& m);
