@@ -170,9 +170,10 @@ TEST(NodeProcesses, TrackingTakesMappingBackWhenTheMappingNodeDies) {
 }
 
 // LM, LC and TR as processes on `domain`, TR on the test sequence in real time. The node of
-// `task` (lm or lc) is killed with kill -9 when TR reaches frame 48 of 240 and started again
-// at frame 120, with its old id and nothing held, writing to <out>/<task>2. After TR's end the
-// others get a minute each to finish, then they are stopped. Returns TR's exit status.
+// `task` is killed with kill -9 when TR reaches frame 48 of 240 and started again, with its
+// old id and nothing held, writing to <out>/<task>2: an LM or LC at frame 120, a TR at once (on
+// the whole sequence again). After TR's end the others get a minute each to finish, then they
+// are stopped. Returns the exit status of the TR that ran last.
 int runWithARestart(const fs::path& out, const std::string& task, int domain) {
   const std::string bin = HIVESLAM_BINARY, d = " --domain " + std::to_string(domain);
   const std::string tr_log = (out / "tr.log").string();
@@ -180,18 +181,21 @@ int runWithARestart(const fs::path& out, const std::string& task, int domain) {
     return "while kill -0 $tr && ! grep -q \"tracking " + std::to_string(frame) + "/240\" " + tr_log + "; do sleep 0.05; done; ";
   };
   auto start = [&](const std::string& t, const std::string& name) {
-    return bin + " node --task " + t + d + " --out " + (out / name).string() + " > " + (out / (name + ".log")).string() +
-           " 2>&1 & " + name + "=$!; ";
+    const std::string input = t == "tr" ? " " + sequence().string() + " --expect lm,lc" + kRealtime : "";
+    return bin + " node --task " + t + input + d + " --out " + (out / name).string() + " > " +
+           (out / (name + ".log")).string() + " 2>&1 & " + name + "=$!; ";
   };
   auto await = [](const std::string& name) {
     return "for i in $(seq 600); do kill -0 $" + name + " 2>/dev/null || break; sleep 0.1; done; ";
   };
-  const std::string other = task == "lm" ? "lc" : "lm";
-  const std::string run = start("lm", "lm") + start("lc", "lc") + bin + " node --task tr " + sequence().string() + d +
-                          " --expect lm,lc" + kRealtime + " --out " + (out / "tr").string() + " > " + tr_log +
-                          " 2>&1 & tr=$!; " + reached(48) + "kill -9 $" + task + "; " + reached(120) +
-                          start(task, task + "2") + "wait $tr; status=$?; " + await(task + "2") + await(other) +
-                          "kill $" + task + "2 $" + other + " 2>/dev/null; wait; exit $status";
+  const bool tracking = task == "tr";
+  const std::string last_tr = tracking ? "tr2" : "tr";
+  std::vector<std::string> others;  // the nodes to let finish after TR
+  for (const std::string t : {"lm", "lc"}) others.push_back(t == task ? t + "2" : t);
+  const std::string run = start("lm", "lm") + start("lc", "lc") + start("tr", "tr") + reached(48) + "kill -9 $" + task +
+                          "; " + (tracking ? "" : reached(120)) + start(task, task + "2") + "wait $" + last_tr +
+                          "; status=$?; " + await(others[0]) + await(others[1]) + "kill $" + others[0] + " $" +
+                          others[1] + " 2>/dev/null; wait; exit $status";
   return std::system(("timeout 300 bash -c '" + run + "'").c_str());
 }
 
@@ -232,6 +236,23 @@ TEST(NodeProcesses, ARestartedLoopClosingNodeTakesTheWholeMapFromTheGateway) {
   EXPECT_EQ(lc2.value("end_of_run", ""), "completed") << std::ifstream(out / "lc2.log").rdbuf();
   // The newcomer holds the whole map in its SLAM map and in S_full, as TR and LM do.
   expectOneMap(tr, lm, lc2);
+}
+
+// The tracking node dies at 20% of the frames and a new one starts the sequence again from its
+// first frame: the gateway hands it the map so far (features included), and whether it
+// relocalizes in that map or starts a new one that LC merges, all three end the run with one map.
+TEST(NodeProcesses, ARestartedTrackingNodeGetsTheMapAndEndsWithOneMap) {
+  testing::TempDir out;
+  const int status = runWithARestart(out.path(), "tr", 10 + getpid() % 40);
+  ASSERT_EQ(status, 0) << std::ifstream(out / "tr2.log").rdbuf();
+  const auto tr2 = report(out / "tr2" / "report.json"), lm = report(out / "lm" / "report.json"),
+             lc = report(out / "lc" / "report.json");
+  EXPECT_EQ(tasks(tr2), std::vector<std::string>{"tr"}) << tr2.dump();
+  EXPECT_EQ(lm.value("end_of_run", ""), "completed") << std::ifstream(out / "lm.log").rdbuf();
+  EXPECT_EQ(lc.value("end_of_run", ""), "completed") << std::ifstream(out / "lc.log").rdbuf();
+  EXPECT_EQ(tr2.value("maps", 0), 1) << std::ifstream(out / "tr2.log").rdbuf();
+  EXPECT_GT(tr2.value("tracked_frames", 0), 200);
+  expectOneMap(tr2, lm, lc);
 }
 
 TEST(NodeProcesses, ThreeNodesInThreeNetworkNamespaces) {
