@@ -173,8 +173,14 @@ TEST(NodeProcesses, TrackingTakesMappingBackWhenTheMappingNodeDies) {
 // `task` is killed with kill -9 when TR reaches frame 48 of 240 and started again, with its
 // old id and nothing held, writing to <out>/<task>2: an LM or LC at frame 120, a TR at once (on
 // the whole sequence again). After TR's end the others get a minute each to finish, then they
-// are stopped. Returns the exit status of the TR that ran last.
-int runWithARestart(const fs::path& out, const std::string& task, int domain) {
+// are stopped. Gives the exit status of the TR that ran last, and each task's report (the
+// restarted node's from <task>2).
+struct RestartRun {
+  int status = -1;
+  nlohmann::json tr, lm, lc;
+};
+
+RestartRun runWithARestart(const fs::path& out, const std::string& task, int domain) {
   const std::string bin = HIVESLAM_BINARY, d = " --domain " + std::to_string(domain);
   const std::string tr_log = (out / "tr.log").string();
   auto reached = [&](int frame) {
@@ -196,7 +202,14 @@ int runWithARestart(const fs::path& out, const std::string& task, int domain) {
                           "; " + (tracking ? "" : reached(120)) + start(task, task + "2") + "wait $" + last_tr +
                           "; status=$?; " + await(others[0]) + await(others[1]) + "kill $" + others[0] + " $" +
                           others[1] + " 2>/dev/null; wait; exit $status";
-  return std::system(("timeout 300 bash -c '" + run + "'").c_str());
+  RestartRun r;
+  r.status = std::system(("timeout 300 bash -c '" + run + "'").c_str());
+  if (r.status != 0) return r;
+  auto of = [&](const std::string& t) { return report(out / (t == task ? t + "2" : t) / "report.json"); };
+  r.tr = of("tr");
+  r.lm = of("lm");
+  r.lc = of("lc");
+  return r;
 }
 
 // The mapping node dies at 20% of the frames and is started again at 50%, as it was (the same
@@ -206,10 +219,8 @@ int runWithARestart(const fs::path& out, const std::string& task, int domain) {
 // keyframes for good: it gets a minute after TR's end, then it is stopped.)
 TEST(NodeProcesses, ARestartedMappingNodeTakesTheMapOverFromTracking) {
   testing::TempDir out;
-  const int status = runWithARestart(out.path(), "lm", 200 + getpid() % 30);
+  const auto [status, tr, lm2, lc] = runWithARestart(out.path(), "lm", 200 + getpid() % 30);
   ASSERT_EQ(status, 0) << std::ifstream(out / "tr.log").rdbuf();
-  const auto tr = report(out / "tr" / "report.json"), lm2 = report(out / "lm2" / "report.json"),
-             lc = report(out / "lc" / "report.json");
   EXPECT_EQ(tasks(tr), std::vector<std::string>{"tr"}) << tr.dump();
   EXPECT_EQ(lm2.value("end_of_run", ""), "completed") << std::ifstream(out / "lm2.log").rdbuf();
   EXPECT_GT(tr["mapping"]["keyframes_processed"].get<int>(), 0);   // TR mapped during the outage
@@ -226,10 +237,8 @@ TEST(NodeProcesses, ARestartedMappingNodeTakesTheMapOverFromTracking) {
 // snapshot's last keyframes (observer_test has the mechanism).
 TEST(NodeProcesses, ARestartedLoopClosingNodeTakesTheWholeMapFromTheGateway) {
   testing::TempDir out;
-  const int status = runWithARestart(out.path(), "lc", 50 + getpid() % 50);
+  const auto [status, tr, lm, lc2] = runWithARestart(out.path(), "lc", 50 + getpid() % 50);
   ASSERT_EQ(status, 0) << std::ifstream(out / "tr.log").rdbuf();
-  const auto tr = report(out / "tr" / "report.json"), lm = report(out / "lm" / "report.json"),
-             lc2 = report(out / "lc2" / "report.json");
   EXPECT_EQ(tasks(tr), std::vector<std::string>{"tr"}) << tr.dump();
   EXPECT_EQ(tasks(lm), std::vector<std::string>{"lm"}) << std::ifstream(out / "lm.log").rdbuf();
   EXPECT_EQ(lm.value("end_of_run", ""), "completed");
@@ -243,10 +252,8 @@ TEST(NodeProcesses, ARestartedLoopClosingNodeTakesTheWholeMapFromTheGateway) {
 // relocalizes in that map or starts a new one that LC merges, all three end the run with one map.
 TEST(NodeProcesses, ARestartedTrackingNodeGetsTheMapAndEndsWithOneMap) {
   testing::TempDir out;
-  const int status = runWithARestart(out.path(), "tr", 10 + getpid() % 40);
+  const auto [status, tr2, lm, lc] = runWithARestart(out.path(), "tr", 10 + getpid() % 40);
   ASSERT_EQ(status, 0) << std::ifstream(out / "tr2.log").rdbuf();
-  const auto tr2 = report(out / "tr2" / "report.json"), lm = report(out / "lm" / "report.json"),
-             lc = report(out / "lc" / "report.json");
   EXPECT_EQ(tasks(tr2), std::vector<std::string>{"tr"}) << tr2.dump();
   EXPECT_EQ(lm.value("end_of_run", ""), "completed") << std::ifstream(out / "lm.log").rdbuf();
   EXPECT_EQ(lc.value("end_of_run", ""), "completed") << std::ifstream(out / "lc.log").rdbuf();
