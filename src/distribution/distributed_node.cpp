@@ -135,13 +135,14 @@ Plan DistributedNode::plan() const {
 }
 
 void DistributedNode::onPeer(const PeerInfo& peer, bool present) {
-  bool newcomer = false;
+  bool newcomer = false, restarted = false;
   const Plan before = plan();
   {
     std::lock_guard lock(mutex_);
     if (present) {
       auto it = peers_.find(peer.node);
       newcomer = it == peers_.end() || it->second.incarnation != peer.incarnation;
+      restarted = it != peers_.end() && newcomer;
       peers_[peer.node] = peer;
     } else {
       peers_.erase(peer.node);
@@ -149,6 +150,11 @@ void DistributedNode::onPeer(const PeerInfo& peer, bool present) {
   }
   spdlog::info("node {}: peer {} ({}) {}", options_.id, peer.name, communication::taskName(peer.task),
                present ? (newcomer ? "joined" : "changed") : "left");
+  // A global map it was sending when it died would otherwise wait here, half collected, until
+  // its next batch: it is never completed.
+  if (!present || restarted)
+    if (const size_t dropped = observer_.dropPendingGlobals(peer.node))
+      spdlog::info("node {}: {} batches of an unfinished global map from {} dropped", options_.id, dropped, peer.name);
   applyPlan();
   // A node that joins late gets the maps so far from the gateway; a mapping node that joins
   // (or returns) gets them from the node that mapped until now, which gives mapping up to it.

@@ -127,6 +127,17 @@ std::optional<std::vector<MapRecord>> Observer::collectGlobal(MapRecord&& batch,
   return all;
 }
 
+size_t Observer::dropPendingGlobals(uint16_t sender) {
+  std::lock_guard lock(mutex_);
+  size_t dropped = 0;
+  std::erase_if(pending_global_, [&](const auto& entry) {
+    if (entry.first.second != sender) return false;
+    dropped += entry.second.size();
+    return true;
+  });
+  return dropped;
+}
+
 bool Observer::hasPoint(Id id) const {
   std::lock_guard lock(mutex_);
   return points_.count(id) > 0;

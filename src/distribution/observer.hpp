@@ -43,6 +43,9 @@ class Observer {
   void revive(const MapRecord& snapshot);
   // A global map's batches from `sender` until the last one is in; returns all batches then.
   std::optional<std::vector<MapRecord>> collectGlobal(MapRecord&& batch, uint16_t sender);
+  // The sender left or came back as a new incarnation: what it had not finished sending will
+  // never be finished (a new incarnation numbers its updates afresh). Returns the batches dropped.
+  size_t dropPendingGlobals(uint16_t sender);
   bool hasPoint(Id id) const;
   StateDigest digest() const;
   size_t keyframeCount() const;

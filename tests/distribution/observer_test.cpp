@@ -68,5 +68,26 @@ TEST(ObserverGlobals, TwoUpdatesWithOneLabelAreCollectedApart) {
   }
 }
 
+// A sender that dies halfway through a global map never finishes it; when it leaves (or comes
+// back as a new incarnation that numbers its updates afresh) its half is dropped, and another
+// sender's collection of the same map is kept.
+TEST(ObserverGlobals, ASenderThatLeavesTakesItsUnfinishedGlobalMapWithIt) {
+  Observer o;
+  constexpr uint16_t kLm = 2, kLc = 3;
+  EXPECT_FALSE(o.collectGlobal(batch(9, 0, 3, /*update=*/4), kLm));
+  EXPECT_FALSE(o.collectGlobal(batch(9, 1, 3, /*update=*/4), kLm));
+  EXPECT_FALSE(o.collectGlobal(batch(5, 0, 2, /*update=*/1), kLc));
+  EXPECT_EQ(o.dropPendingGlobals(kLm), 2u);
+  EXPECT_EQ(o.dropPendingGlobals(kLm), 0u);
+  // The returning LM's first update, of an epoch below the dead one's, is collected whole.
+  EXPECT_FALSE(o.collectGlobal(batch(2, 0, 2, /*update=*/1), kLm));
+  const auto lm = o.collectGlobal(batch(2, 1, 2, /*update=*/1), kLm);
+  ASSERT_TRUE(lm);
+  EXPECT_EQ(lm->size(), 2u);
+  const auto lc = o.collectGlobal(batch(5, 1, 2, /*update=*/1), kLc);
+  ASSERT_TRUE(lc);
+  EXPECT_EQ(lc->front().epoch, 5u);
+}
+
 }  // namespace
 }  // namespace hiveslam::distribution
