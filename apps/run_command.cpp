@@ -228,7 +228,8 @@ RunSummary runSlam(const RunOptions& o) {
                            {"query_ms_mean", ls.query_ms_total / std::max(ls.keyframes_checked, 1)},
                            {"rejected_geometry", ls.rejected_geometry},
                            {"global_bas_discarded", ls.global_bas_discarded},
-                           {"global_ba_ms", ls.global_ba_ms}};
+                           {"global_ba_ms", ls.global_ba_ms},
+                           {"global_ba_sigma", ls.global_ba_sigma}};
   if (const auto* topic = dynamic_cast<const TopicFrameSource*>(source.get()))
     dropped += static_cast<int>(topic->dropped());  // images the reader had to let go
   const bool realtime = mode == core::SlamSystem::Mode::Realtime;

@@ -88,8 +88,20 @@ TEST(SlamSystem, ThreadedModeTracks) {
   EXPECT_LT(ate.stats.rmse, 0.02 * ate.reference_length) << ate.stats.rmse << " m over " << ate.reference_length;
 }
 
+// Where the path comes back to its start: how far the estimate's displacement between the
+// start and the revisit is from the true one, after aligning the whole trajectory. Open loop,
+// this is the drift accumulated over the lap; a closed loop takes it out.
+double revisitGap(const eval::AteResult& ate) {
+  const auto& ref = ate.pair.ref.poses;
+  const auto& est = ate.pair.est.poses;
+  size_t back = ref.size() - 1;
+  for (size_t j = ref.size() * 3 / 4; j < ref.size(); ++j)
+    if ((ref[j].translation() - ref[0].translation()).norm() < (ref[back].translation() - ref[0].translation()).norm()) back = j;
+  return ((est[back].translation() - est[0].translation()) - (ref[back].translation() - ref[0].translation())).norm();
+}
+
 // The whole loop at twice the suite's speed: the revisit of the start is recognized, the loop
-// closed, and the corrected trajectory is at least as good as the open-loop one.
+// closed, and the drift the open-loop run carries back to the start is taken out.
 TEST(SlamSystem, ClosesTheLoopOfARenderedLoop) {
   const SlamRun open = runSequence("loop", 500, 0, 500, 1, SlamSystem::Mode::Sequential);
   const SlamRun closed = runSequence("loop", 500, 0, 500, 1, SlamSystem::Mode::Sequential, shippedVocabulary());
@@ -98,7 +110,12 @@ TEST(SlamSystem, ClosesTheLoopOfARenderedLoop) {
   const auto ate_open = eval::computeAte(open.truth, open.estimate);
   const auto ate_closed = eval::computeAte(closed.truth, closed.estimate);
   EXPECT_LT(ate_closed.stats.rmse, 0.01 * ate_closed.reference_length);
-  EXPECT_LE(ate_closed.stats.rmse, ate_open.stats.rmse) << ate_closed.stats.rmse << " vs " << ate_open.stats.rmse;
+  // Over the whole 500-frame lap both runs are near 4 mm, and which is lower is a draw (4.1
+  // against 4.25 mm, and 4.45 against 4.25 once global BA judged by the map's noise). At the
+  // revisit, the open run's drift stands apart: 12.3 mm against 3.5-3.9 closed.
+  EXPECT_LT(revisitGap(ate_closed), 0.5 * revisitGap(ate_open))
+      << revisitGap(ate_closed) << " vs " << revisitGap(ate_open) << " (ATE " << ate_closed.stats.rmse << " vs "
+      << ate_open.stats.rmse << ")";
 }
 
 // Tracking is lost in the blank frames and a new map starts after them; recognizing the old

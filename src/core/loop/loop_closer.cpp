@@ -457,6 +457,15 @@ void LoopCloser::globalBundleAdjustment(Map& map, int iterations) {
   BaOptions o;
   o.iterations = iterations > 0 ? iterations : settings_.global_ba_iterations;
   o.outlier_round = false;
+  if (settings_.global_ba_noise_factor > 0) {
+    // Observations the map's own noise calls outliers sit this BA out; they stay in the map.
+    // A tenth of a pixel at the least: a map fitted exactly (a test's noiseless one) would
+    // otherwise call every rounding error an outlier.
+    const double sigma = std::clamp(settings_.global_ba_noise_factor * medianResidualSigma(ba), 0.1, 1.0);
+    setNoise(ba, sigma);
+    o.outlier_round = true;
+    stats_.global_ba_sigma = sigma;
+  }
   bundleAdjust(ba, o);
   for (size_t i = 0; i < kfs.size(); ++i) correction.after[kfs[i]] = Sim3(ba.poses[i].q_cw, ba.poses[i].t_cw, 1.0);
   for (size_t i = 0; i < pts.size(); ++i) correction.points[pts[i]] = ba.points[i].p_w;

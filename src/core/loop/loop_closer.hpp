@@ -42,6 +42,7 @@ struct LoopStats {
   int keyframes_checked = 0, loops = 0, merges = 0, global_bas = 0, global_bas_discarded = 0;
   int rejected_geometry = 0;  // consistent places that failed Sim3 verification
   double query_ms_total = 0, global_ba_ms_total = 0;
+  double global_ba_sigma = 0;  // the noise the last global BA judged residuals by, in level sigmas
   std::vector<LoopEvent> events;
   std::vector<std::pair<int, double>> global_ba_ms;  // (keyframes, ms) per global BA
 };

@@ -1,6 +1,9 @@
 #include "core/optim/bundle_adjustment.hpp"
 
 #include <ceres/ceres.h>
+
+#include <algorithm>
+#include <cmath>
 #include "core/optim/reprojection_error.hpp"
 
 namespace hiveslam::core {
@@ -100,6 +103,25 @@ BaSummary bundleAdjust(BaProblem& pb, const BaOptions& o) {
   out.converged = summary.termination_type == ceres::CONVERGENCE;
   out.final_cost = summary.final_cost;
   return out;
+}
+
+double medianResidualSigma(const BaProblem& pb) {
+  std::vector<double> r;
+  r.reserve(pb.observations.size());
+  for (const auto& ob : pb.observations) {
+    const auto& pose = pb.poses[static_cast<size_t>(ob.pose)];
+    const Eigen::Vector3d pc = pose.q_cw * pb.points[static_cast<size_t>(ob.point)].p_w + pose.t_cw;
+    if (pc.z() <= kMinCosOffAxis * pc.norm()) continue;
+    r.push_back((pb.K.project(pc) - ob.uv).norm() * ob.inv_sigma);
+  }
+  if (r.empty()) return 0.0;
+  auto mid = r.begin() + static_cast<std::ptrdiff_t>(r.size() / 2);
+  std::nth_element(r.begin(), mid, r.end());
+  return *mid / std::sqrt(2.0 * std::log(2.0));
+}
+
+void setNoise(BaProblem& pb, double sigma) {
+  for (auto& ob : pb.observations) ob.inv_sigma /= sigma;
 }
 
 }  // namespace hiveslam::core

@@ -52,4 +52,14 @@ struct BaSummary {
 
 BaSummary bundleAdjust(BaProblem& problem, const BaOptions& options = {});
 
+// The observations' noise per coordinate, in units of their level sigmas, read off the median
+// reprojection error as a 2D Gaussian's (the median of its norm is sqrt(2 ln 2) = 1.1774
+// sigmas), so the few observations far off do not inflate it. 0 without observations.
+double medianResidualSigma(const BaProblem& problem);
+
+// Expresses every observation's weight in units of `sigma` level sigmas (sigma < 1: the
+// measurements are more precise than one pixel per level), so that the Huber kernel and the
+// chi-square test of the outlier round judge residuals against the noise the map really has.
+void setNoise(BaProblem& problem, double sigma);
+
 }  // namespace hiveslam::core
