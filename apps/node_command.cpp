@@ -70,6 +70,7 @@ void serve(const NodeCommandOptions& o, communication::Task task) {
   report["loops"] = ls.loops;
   report["merges"] = ls.merges;
   report["global_bas"] = ls.global_bas;
+  report["global_ba_sigma"] = ls.global_ba_sigma;  // 0 on a node that ran none
   report["loop_events"] = loopEventsJson(ls);
   size_t kfs = 0, points = 0;
   report["map_keyframes"] = nlohmann::json::array();
