@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include "core/optim/reprojection_error.hpp"
 
 namespace hiveslam::core {
@@ -11,6 +12,15 @@ namespace hiveslam::core {
 namespace {
 
 constexpr double kMinCosOffAxis = 0.1;  // cos 84.3 deg
+
+// An observation's reprojection error in units of its level sigma; infinite for a point
+// beside or behind the camera (see below).
+double levelError(const BaProblem& pb, const BaObservation& ob) {
+  const auto& pose = pb.poses[static_cast<size_t>(ob.pose)];
+  const Eigen::Vector3d pc = pose.q_cw * pb.points[static_cast<size_t>(ob.point)].p_w + pose.t_cw;
+  if (pc.z() <= kMinCosOffAxis * pc.norm()) return std::numeric_limits<double>::infinity();
+  return (pb.K.project(pc) - ob.uv).norm() * ob.inv_sigma;
+}
 
 class AbortCallback : public ceres::IterationCallback {
  public:
@@ -76,13 +86,7 @@ BaSummary bundleAdjust(BaProblem& pb, const BaOptions& o) {
   out.iterations = static_cast<int>(summary.iterations.size());
   auto classify = [&]() {
     out.outlier.assign(pb.observations.size(), false);
-    for (size_t i = 0; i < pb.observations.size(); ++i) {
-      const auto& ob = pb.observations[i];
-      const auto& pose = pb.poses[static_cast<size_t>(ob.pose)];
-      const Eigen::Vector3d pc = pose.q_cw * pb.points[static_cast<size_t>(ob.point)].p_w + pose.t_cw;
-      const double chi2 = pc.z() <= kMinCosOffAxis * pc.norm() ? 1e9 : ((pb.K.project(pc) - ob.uv) * ob.inv_sigma).squaredNorm();
-      out.outlier[i] = chi2 > 5.991;
-    }
+    for (size_t i = 0; i < pb.observations.size(); ++i) out.outlier[i] = levelError(pb, pb.observations[i]) > std::sqrt(5.991);
   };
   classify();
   // Second round without the outliers: even under a robust kernel they pull the solution.
@@ -108,12 +112,8 @@ BaSummary bundleAdjust(BaProblem& pb, const BaOptions& o) {
 double medianResidualSigma(const BaProblem& pb) {
   std::vector<double> r;
   r.reserve(pb.observations.size());
-  for (const auto& ob : pb.observations) {
-    const auto& pose = pb.poses[static_cast<size_t>(ob.pose)];
-    const Eigen::Vector3d pc = pose.q_cw * pb.points[static_cast<size_t>(ob.point)].p_w + pose.t_cw;
-    if (pc.z() <= kMinCosOffAxis * pc.norm()) continue;
-    r.push_back((pb.K.project(pc) - ob.uv).norm() * ob.inv_sigma);
-  }
+  for (const auto& ob : pb.observations)
+    if (const double e = levelError(pb, ob); std::isfinite(e)) r.push_back(e);
   if (r.empty()) return 0.0;
   auto mid = r.begin() + static_cast<std::ptrdiff_t>(r.size() / 2);
   std::nth_element(r.begin(), mid, r.end());
