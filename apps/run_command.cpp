@@ -209,6 +209,7 @@ RunSummary runSlam(const RunOptions& o) {
   report["tracked_frames"] = tracked;
   report["frames_refined"] = frames_refined;
   report["failures"] = slam.failures();
+  report["keyframes_deferred"] = slam.keyframesDeferred();
   report["keyframes"] = keyframe_count;
   report["maps"] = maps.size();
   report["map_keyframes"] = nlohmann::json::array();

@@ -95,6 +95,7 @@ class SlamSystem {
   const std::vector<FrameRecord>& frames() const { return records_; }
   std::vector<std::shared_ptr<Map>> maps() const;
   int failures() const { return tracker_.failures(); }
+  int keyframesDeferred() const { return tracker_.keyframesDeferred(); }
   const MappingStats& mappingStats() const { return mapper_.stats(); }
   const LoopStats& loopStats() const { return closer_.stats(); }
   // The map a frame's poses live in now (a merged map's frames live in the map it joined).

@@ -97,6 +97,8 @@ TrackingOutput Tracker::track(Frame frame, bool mapping_idle) {
     ++keyframes_made_;
     reference_ = out.new_keyframe;
     last_keyframe_frame_ = current.frame.index;
+  } else if (!localization_only_ && !mapping_idle && keyframeWanted(current)) {
+    ++keyframes_deferred_;
   }
   out.reference = out.new_keyframe ? out.new_keyframe : nearestKeyframe(current);
   out.T_c_ref = out.reference->relative(current.T_cw);

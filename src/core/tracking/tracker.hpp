@@ -57,6 +57,9 @@ class Tracker {
   void setLocalizationOnly(bool on) { localization_only_ = on; }
   TrackingState state() const { return state_; }
   int failures() const { return failures_; }
+  // Frames at which a keyframe was due but mapping was busy (real-time runs): how often the
+  // keyframe decision waited on mapping, local or remote.
+  int keyframesDeferred() const { return keyframes_deferred_; }
   const std::shared_ptr<Map>& map() const { return map_; }
 
  private:
@@ -98,6 +101,7 @@ class Tracker {
   // Keyframes this tracker made for the current map: unlike the map's own count it does not lag
   // behind a busy local mapping thread.
   int keyframes_made_ = 0;
+  int keyframes_deferred_ = 0;
   std::function<void()> wait_for_mapping_;
   const place::Vocabulary* vocabulary_ = nullptr;
   const KeyframeDatabase* database_ = nullptr;
