@@ -115,6 +115,17 @@ void MapHandler::markDirty(const std::shared_ptr<core::Map>& map, const core::Ke
       for (const core::KeyFrame* k : changed)
         for (const auto& p : k->points)
           if (p && !p->bad) points.push_back(p->id);
+      // The other observers of kf's points go too, without their points: triangulation and
+      // fusion gave them observations of kf's points, and a point's observers are read off the
+      // keyframes' matches. Sent with kf alone, a point triangulated between kf and a neighbour
+      // had one observer at TR until the neighbour's record came after local BA, so TR's
+      // reference keyframes counted fewer well-observed points than the standalone system's
+      // (offline sweep, in the turn: 283 against 362) and asked for fewer keyframes.
+      std::set<core::Id> in(kfs.begin(), kfs.end());
+      for (const auto& p : kf.points)
+        if (p && !p->bad)
+          for (const auto& [o, idx] : p->observations)
+            if (!o->bad && in.insert(o->id).second) kfs.push_back(o->id);
     }
   }
   {
