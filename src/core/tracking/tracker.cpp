@@ -92,12 +92,13 @@ TrackingOutput Tracker::track(Frame frame, bool mapping_idle) {
     optimize(current);
     out.T_cw = current.T_cw;
   }
-  if (!localization_only_ && needKeyframe(current, mapping_idle)) {
+  const KeyframeDecision decision = localization_only_ ? KeyframeDecision::None : keyframeDecision(current, mapping_idle);
+  if (decision == KeyframeDecision::Make) {
     out.new_keyframe = makeKeyframe(current);
     ++keyframes_made_;
     reference_ = out.new_keyframe;
     last_keyframe_frame_ = current.frame.index;
-  } else if (!localization_only_ && !mapping_idle && keyframeWanted(current)) {
+  } else if (decision == KeyframeDecision::Deferred) {
     ++keyframes_deferred_;
   }
   out.reference = out.new_keyframe ? out.new_keyframe : nearestKeyframe(current);
@@ -447,14 +448,15 @@ bool Tracker::keyframeWanted(const Tracked& c) const {
   return inliers_ < settings_.keyframe_ratio * reference_points && inliers_ > settings_.keyframe_min_inliers;
 }
 
-bool Tracker::needKeyframe(const Tracked& c, bool mapping_idle) const {
+Tracker::KeyframeDecision Tracker::keyframeDecision(const Tracked& c, bool mapping_idle) const {
   const size_t since = c.frame.index - last_keyframe_frame_;
-  if (since < static_cast<size_t>(settings_.keyframe_min_frames)) return false;
+  if (since < static_cast<size_t>(settings_.keyframe_min_frames)) return KeyframeDecision::None;
   if (c.frame.index < last_relocalization_frame_ + static_cast<size_t>(settings_.keyframe_max_frames) &&
       keyframes_made_ > settings_.keyframe_max_frames)
-    return false;
+    return KeyframeDecision::None;
+  if (!keyframeWanted(c)) return KeyframeDecision::None;
   const bool timely = since >= static_cast<size_t>(settings_.keyframe_max_frames) || mapping_idle;
-  return timely && keyframeWanted(c);
+  return timely ? KeyframeDecision::Make : KeyframeDecision::Deferred;
 }
 
 void Tracker::describePlace(KeyFrame& kf) const {

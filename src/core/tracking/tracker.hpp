@@ -79,7 +79,9 @@ class Tracker {
                                                                   place::FeatureVector& features) const;
   void describePlace(KeyFrame& kf) const;
   int optimize(Tracked& current);
-  bool needKeyframe(const Tracked& current, bool mapping_idle) const;
+  // Made, or due but held back because mapping is busy (counted as deferred), or neither.
+  enum class KeyframeDecision { None, Make, Deferred };
+  KeyframeDecision keyframeDecision(const Tracked& current, bool mapping_idle) const;
   bool keyframeWanted(const Tracked& current) const;  // the point-ratio half of the decision
   std::shared_ptr<KeyFrame> makeKeyframe(const Tracked& current);
   // The keyframe a tracked frame's pose is kept relative to (TrackingOutput::reference).
