@@ -1,5 +1,7 @@
 #pragma once
-// A fresh folder under the system temp dir, removed with everything in it at scope exit.
+// A fresh folder under the system temp dir, removed with everything in it at scope exit, unless
+// HIVESLAM_KEEP_TEST_DIRS is set (to read a failed test's node logs afterwards).
+#include <cstdlib>
 #include <filesystem>
 #include <random>
 #include <string>
@@ -15,6 +17,7 @@ class TempDir {
     std::filesystem::create_directories(path_);
   }
   ~TempDir() {
+    if (std::getenv("HIVESLAM_KEEP_TEST_DIRS")) return;
     std::error_code ec;
     std::filesystem::remove_all(path_, ec);
   }

@@ -8,6 +8,7 @@
 #include <cstdlib>
 #include <fstream>
 #include <nlohmann/json.hpp>
+#include <sstream>
 
 #include "synth/sequence.hpp"
 #include "temp_dir.hpp"
@@ -43,6 +44,41 @@ nlohmann::json report(const fs::path& file) {
   std::ifstream in(file);
   EXPECT_TRUE(in.good()) << file;
   return in ? nlohmann::json::parse(in) : nlohmann::json::object();
+}
+
+// Whether a node's frame log (frames.csv: index, timestamp, tracked, ...) shows it tracking
+// through the last quarter of its run: at least 10 frames there and 9 in 10 of them tracked.
+::testing::AssertionResult tracksTheLastQuarter(const fs::path& frame_log) {
+  std::ifstream in(frame_log);
+  std::string line;
+  std::getline(in, line);  // the header
+  std::vector<std::pair<double, bool>> frames;
+  while (std::getline(in, line)) {
+    std::istringstream row(line);
+    std::string index, stamp, tracked;
+    std::getline(row, index, ',');
+    std::getline(row, stamp, ',');
+    std::getline(row, tracked, ',');
+    frames.emplace_back(std::stod(stamp), tracked == "1");
+  }
+  if (frames.empty()) return ::testing::AssertionFailure() << "no frames in " << frame_log;
+  const double from = frames.front().first + 0.75 * (frames.back().first - frames.front().first);
+  int seen = 0, tracked = 0;
+  for (const auto& [stamp, ok] : frames)
+    if (stamp >= from) ++seen, tracked += ok;
+  if (seen >= 10 && 10 * tracked >= 9 * seen) return ::testing::AssertionSuccess();
+  return ::testing::AssertionFailure() << tracked << " of the last quarter's " << seen << " frames tracked";
+}
+
+// A shell loop that returns once TR (pid $tr, progress in `log`) has read frame `frame` of 240 or
+// has ended. TR prints its progress every 10% at the first frame it processes past each step: a
+// real-time TR that drops the step's own frame prints a later one ("tracking 123/240"), and a
+// wait for the exact number then lasted until TR had ended (the node it was to start found no
+// one left to join).
+std::string untilFrame(int frame, const fs::path& log) {
+  return "until ! kill -0 $tr || [ \"$(grep -o \"tracking [0-9]*/240\" " + log.string() +
+         " | tail -n 1 | cut -d\" \" -f2 | cut -d/ -f1)\" -ge " + std::to_string(frame) +
+         " ] 2>/dev/null; do sleep 0.05; done; ";
 }
 
 std::vector<std::string> tasks(const nlohmann::json& r) { return r.value("tasks", std::vector<std::string>{}); }
@@ -155,16 +191,18 @@ TEST(NodeProcesses, TrackingTakesMappingBackWhenTheMappingNodeDies) {
       " 2>&1 & lm=$!; " + bin + " node --task lc" + domain + " --out " + (out / "lc").string() + " > " +
       (out / "lc.log").string() + " 2>&1 & lc=$!; " + bin + " node --task tr " + sequence().string() + domain +
       " --expect lm,lc" + kRealtime + " --out " + (out / "tr").string() + " > " + (out / "tr.log").string() +
-      " 2>&1 & tr=$!; while kill -0 $tr && ! grep -q \"tracking 72/240\" " + (out / "tr.log").string() +
-      "; do sleep 0.05; done; kill -9 $lm; wait $tr; status=$?; kill $lc; wait; exit $status";
+      " 2>&1 & tr=$!; " + untilFrame(72, out / "tr.log") + "kill -9 $lm; wait $tr; status=$?; kill $lc; wait; exit $status";
   const int status = std::system(("timeout 300 bash -c '" + run + "'").c_str());
   ASSERT_EQ(status, 0) << std::ifstream(out / "tr.log").rdbuf();
   const auto tr = report(out / "tr" / "report.json");
   const auto hosted = tasks(tr);
   EXPECT_NE(std::find(hosted.begin(), hosted.end(), "lm"), hosted.end()) << tr.dump();
-  // The take-over costs frames today (measured: 84% tracked, one tracking failure, ~30
-  // frames dropped on a 500-frame loop; docs/BENCHMARKS.md): the bound says the run goes on.
-  EXPECT_GT(tr.value("tracked_frames", 0), 150);
+  // The take-over costs frames today: TR's map gets no new points from the death until the
+  // lease ends, tracking is lost for about a second and the slow relocalization attempts make
+  // a real-time TR drop frames (docs/BENCHMARKS.md, session 30). How many it keeps depends on
+  // the machine's load (149 to 167 of 240 seen with a second test running), so the test asks
+  // what does not: that TR tracks again after the take-over and to the end.
+  EXPECT_TRUE(tracksTheLastQuarter(out / "tr" / "frames.csv"));
   EXPECT_LT(tr["ate"]["percent_of_path"].get<double>(), 1.0);
   EXPECT_GT(tr["mapping"]["keyframes_processed"].get<int>(), 0);  // it mapped after the LM left
 }
@@ -182,10 +220,7 @@ struct RestartRun {
 
 RestartRun runWithARestart(const fs::path& out, const std::string& task, int domain) {
   const std::string bin = HIVESLAM_BINARY, d = " --domain " + std::to_string(domain);
-  const std::string tr_log = (out / "tr.log").string();
-  auto reached = [&](int frame) {
-    return "while kill -0 $tr && ! grep -q \"tracking " + std::to_string(frame) + "/240\" " + tr_log + "; do sleep 0.05; done; ";
-  };
+  auto reached = [&](int frame) { return untilFrame(frame, out / "tr.log"); };
   auto start = [&](const std::string& t, const std::string& name) {
     const std::string input = t == "tr" ? " " + sequence().string() + " --expect lm,lc" + kRealtime : "";
     return bin + " node --task " + t + input + d + " --out " + (out / name).string() + " > " +
