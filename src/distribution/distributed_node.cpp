@@ -335,6 +335,8 @@ void DistributedNode::onGlobal(std::vector<MapRecord>&& batches, Topic topic) {
     if (it != published_.end() && it->second != epoch) {
       ++globals_ignored_;
       ignore = true;
+      spdlog::info("node {}: global map {} of epoch {} ignored (this node published epoch {})", options_.id, map_id,
+                   epoch, it->second);
     }
   }
   if (!ignore && integrator_.applyGlobal(batches, true)) {
@@ -348,6 +350,8 @@ void DistributedNode::onGlobal(std::vector<MapRecord>&& batches, Topic topic) {
   if (!ignore) {
     std::lock_guard lock(mutex_);
     ++globals_ignored_;  // older than the map here (a correction made here, not yet out)
+    spdlog::info("node {}: global map {} of epoch {} ignored (the map here has left that frame)", options_.id, map_id,
+                 epoch);
   }
   // Still, what is new here (points LM made) and what LM erased is taken, and the keyframes a
   // snapshot brings that this node never got: the one a mapping node mapped as it died, those

@@ -1,5 +1,7 @@
 #include "distribution/observer.hpp"
 
+#include <spdlog/spdlog.h>
+
 namespace hiveslam::distribution {
 
 void Observer::record(const KeyFrameRecord& k) {
@@ -116,6 +118,8 @@ std::optional<std::vector<MapRecord>> Observer::collectGlobal(MapRecord&& batch,
   if (!pending.empty() && (pending.front().epoch != batch.epoch || pending.front().update != batch.update ||
                            pending.front().batches != batch.batches)) {
     if (pending.front().epoch > batch.epoch) return std::nullopt;  // a late batch of an older update
+    spdlog::info("global map {} from node {} cut short: {} of its {} batches came", batch.map, sender, pending.size(),
+                 pending.front().batches);
     pending.clear();
   }
   for (const auto& b : pending)

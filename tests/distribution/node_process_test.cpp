@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cstdlib>
 #include <fstream>
+#include <iostream>
 #include <nlohmann/json.hpp>
 #include <sstream>
 
@@ -218,6 +219,21 @@ struct RestartRun {
   nlohmann::json tr, lm, lc;
 };
 
+// The event lines (peers, hand-overs, ignored or cut-short maps) of every node log in `out`,
+// without the progress lines: what a failed run's cause is read from in CI, where the test's
+// folder is gone afterwards.
+std::string nodeEvents(const fs::path& out) {
+  std::string all;
+  for (const auto& entry : fs::directory_iterator(out)) {
+    if (entry.path().extension() != ".log") continue;
+    all += "--- " + entry.path().filename().string() + "\n";
+    std::ifstream in(entry.path());
+    for (std::string line; std::getline(in, line);)
+      if (line.find("tracking ") == std::string::npos) all += line + "\n";
+  }
+  return all;
+}
+
 RestartRun runWithARestart(const fs::path& out, const std::string& task, int domain) {
   const std::string bin = HIVESLAM_BINARY, d = " --domain " + std::to_string(domain);
   auto reached = [&](int frame) { return untilFrame(frame, out / "tr.log"); };
@@ -262,6 +278,7 @@ TEST(NodeProcesses, ARestartedMappingNodeTakesTheMapOverFromTracking) {
   EXPECT_GT(lm2["mapping"]["keyframes_processed"].get<int>(), 0);  // and the newcomer after it
   // The newcomer holds the whole map, not only what it mapped itself.
   expectOneMap(tr, lm2, lc);
+  if (HasFailure()) std::cout << nodeEvents(out.path());
 }
 
 // The loop-closing node dies at 20% of the frames and is started again at 50%: the gateway
@@ -280,6 +297,7 @@ TEST(NodeProcesses, ARestartedLoopClosingNodeTakesTheWholeMapFromTheGateway) {
   EXPECT_EQ(lc2.value("end_of_run", ""), "completed") << std::ifstream(out / "lc2.log").rdbuf();
   // The newcomer holds the whole map in its SLAM map and in S_full, as TR and LM do.
   expectOneMap(tr, lm, lc2);
+  if (HasFailure()) std::cout << nodeEvents(out.path());
 }
 
 // The tracking node dies at 20% of the frames and a new one starts the sequence again from its
@@ -295,6 +313,7 @@ TEST(NodeProcesses, ARestartedTrackingNodeGetsTheMapAndEndsWithOneMap) {
   EXPECT_EQ(tr2.value("maps", 0), 1) << std::ifstream(out / "tr2.log").rdbuf();
   EXPECT_GT(tr2.value("tracked_frames", 0), 200);
   expectOneMap(tr2, lm, lc);
+  if (HasFailure()) std::cout << nodeEvents(out.path());
 }
 
 TEST(NodeProcesses, ThreeNodesInThreeNetworkNamespaces) {

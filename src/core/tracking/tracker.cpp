@@ -449,12 +449,11 @@ bool Tracker::keyframeWanted(const Tracked& c) const {
 }
 
 Tracker::KeyframeDecision Tracker::keyframeDecision(const Tracked& c, bool mapping_idle) const {
-  const size_t since = c.frame.index - last_keyframe_frame_;
-  if (since < static_cast<size_t>(settings_.keyframe_min_frames)) return KeyframeDecision::None;
   if (c.frame.index < last_relocalization_frame_ + static_cast<size_t>(settings_.keyframe_max_frames) &&
       keyframes_made_ > settings_.keyframe_max_frames)
     return KeyframeDecision::None;
-  if (!keyframeWanted(c)) return KeyframeDecision::None;
+  if (!keyframeWanted(c)) return KeyframeDecision::None;  // also: too soon after the last one
+  const size_t since = c.frame.index - last_keyframe_frame_;
   const bool timely = since >= static_cast<size_t>(settings_.keyframe_max_frames) || mapping_idle;
   return timely ? KeyframeDecision::Make : KeyframeDecision::Deferred;
 }
