@@ -12,6 +12,9 @@ namespace hiveslam::communication {
 
 struct TopicTraffic {
   uint64_t bytes_out = 0, bytes_in = 0, messages_out = 0, messages_in = 0;
+  // Packets that never went out (a write the middleware refused) or never came (a reliable
+  // reader told its writer no longer held them: a reader that fell behind a keep-last history).
+  uint64_t writes_failed = 0, messages_lost = 0;
 };
 using TrafficReport = std::map<std::string, TopicTraffic>;  // by topic name, only topics used
 
@@ -19,12 +22,15 @@ class TrafficCounter {
  public:
   void sent(Topic t, size_t bytes) { add(t, bytes, 0); }
   void received(Topic t, size_t bytes) { add(t, bytes, 1); }
+  void writeFailed(Topic t) { ++counts_[static_cast<size_t>(t)].writes_failed; }
+  void lost(Topic t, uint64_t messages) { counts_[static_cast<size_t>(t)].lost += messages; }
   TrafficReport report() const;
 
  private:
   void add(Topic t, size_t bytes, int dir);
   struct Counts {
     std::atomic<uint64_t> bytes[2]{0, 0}, messages[2]{0, 0};
+    std::atomic<uint64_t> writes_failed{0}, lost{0};
   };
   std::array<Counts, kTopicCount> counts_;
 };

@@ -516,8 +516,9 @@ nlohmann::json DistributedNode::report(double seconds) const {
   uint64_t bytes_out = 0, bytes_in = 0, msgs_out = 0, msgs_in = 0, kf_msgs = 0, map_msgs = 0;
   nlohmann::json topics = nlohmann::json::object();
   for (const auto& [name, t] : transport_.traffic()) {
-    topics[name] = {{"bytes_out", t.bytes_out}, {"bytes_in", t.bytes_in}, {"messages_out", t.messages_out},
-                    {"messages_in", t.messages_in}};
+    topics[name] = {{"bytes_out", t.bytes_out},       {"bytes_in", t.bytes_in},
+                    {"messages_out", t.messages_out}, {"messages_in", t.messages_in},
+                    {"writes_failed", t.writes_failed}, {"messages_lost", t.messages_lost}};
     bytes_out += t.bytes_out;
     bytes_in += t.bytes_in;
     msgs_out += t.messages_out;

@@ -17,6 +17,8 @@
 #include <fastdds/rtps/common/InstanceHandle.h>
 #include <fastdds/rtps/transport/UDPv4TransportDescriptor.h>
 
+#include <spdlog/spdlog.h>
+
 #include <array>
 #include <atomic>
 #include <chrono>
@@ -150,6 +152,12 @@ struct DdsTransport::Impl : public dds::DomainParticipantListener {
         impl->counter.received(topic, m.wireSize());
         handler(std::move(m));
       }
+    }
+    // The writer no longer held packets this reader had not acknowledged (keep-last history):
+    // whatever they carried reaches this node only with a later snapshot.
+    void on_sample_lost(dds::DataReader*, const dds::SampleLostStatus& status) override {
+      impl->counter.lost(topic, static_cast<uint64_t>(status.total_count_change));
+      spdlog::warn("node {}: {} packets lost on {}", impl->self_node.load(), status.total_count_change, topicName(topic));
     }
   };
 
@@ -334,7 +342,12 @@ void DdsTransport::publish(Topic topic, Message&& m) {
   // Held through the write: stop() deletes the writers under it.
   std::lock_guard lock(d.entities);
   if (d.closed) return;
-  if (d.writerFor(topic)->write(&p)) d.counter.sent(topic, bytes);
+  if (d.writerFor(topic)->write(&p)) {
+    d.counter.sent(topic, bytes);
+  } else {
+    d.counter.writeFailed(topic);
+    spdlog::warn("node {}: a write on {} failed ({} bytes)", d.self_node.load(), topicName(topic), bytes);
+  }
 }
 
 void DdsTransport::subscribe(Topic topic, Handler handler) {
