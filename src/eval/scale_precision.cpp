@@ -83,7 +83,7 @@ ScalePrecision computeScalePrecision(const core::BaProblem& problem, const std::
   std::normal_distribution<double> normal(0.0, 1.0);
   core::BaOptions ba;
   ba.iterations = options.iterations;
-  ba.outlier_round = false;
+  ba.outliers = core::Outliers::Kept;
   for (int t = 0; t < options.trials; ++t) {
     core::BaProblem noisy = clean;
     for (auto& ob : noisy.observations) ob.uv += Eigen::Vector2d(normal(rng), normal(rng)) * (out.noise / ob.inv_sigma);

@@ -79,6 +79,7 @@ void applySlamSettings(const std::filesystem::path& file, core::SlamSettings& s)
       {"essential_graph_iterations", set(s.essential_graph_iterations)},
       {"global_ba_iterations", set(s.global_ba_iterations)},
       {"global_ba_noise_factor", set(s.global_ba_noise_factor)},
+      {"global_ba_outliers_from_start", set(s.global_ba_outliers_from_start)},
       {"global_ba_every_keyframes", set(s.global_ba_every_keyframes)},
       {"final_global_ba_iterations", set(s.final_global_ba_iterations)},
       {"refine_frames", set(s.refine_frames)},

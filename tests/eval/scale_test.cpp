@@ -91,7 +91,7 @@ TEST(ScalePrecision, ResidualNoiseOfAFittedMapGivesBackTheNoiseThatWasAdded) {
   WallWalk w = wallWalk(0.5);
   core::BaOptions o;
   o.iterations = 30;
-  o.outlier_round = false;
+  o.outliers = core::Outliers::Kept;
   core::bundleAdjust(w.problem, o);
   EXPECT_NEAR(residualNoise(w.problem), 0.5, 0.03);
   EXPECT_NEAR(residualNoise(wallWalk(0.0).problem), 0.0, 1e-9);

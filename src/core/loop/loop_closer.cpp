@@ -290,7 +290,7 @@ void LoopCloser::process(const std::shared_ptr<Map>& map_handle, const std::shar
       keyframes_since_loop_ = 0;
       stats_.events.back().correct_ms = msSince(t0);
       report(GlobalUpdate::Kind::Merge, map.id, other->id);
-      globalBundleAdjustment(map);
+      globalBundleAdjustment(map, 0, true);
       return;
     }
   }
@@ -323,7 +323,7 @@ void LoopCloser::process(const std::shared_ptr<Map>& map_handle, const std::shar
     report(GlobalUpdate::Kind::Loop, map.id);
     loop_groups_.clear();
     keyframes_since_loop_ = 0;
-    globalBundleAdjustment(map);
+    globalBundleAdjustment(map, 0, true);
     return;
   }
   // No loop: the map still gets a global BA each time it has grown by global_ba_every_keyframes.
@@ -438,7 +438,7 @@ void LoopCloser::optimizeEssentialGraph(Map& map, const LoopCorrection& c, LoopE
   event.essential_graph_ms = msSince(t0);
 }
 
-void LoopCloser::globalBundleAdjustment(Map& map, int iterations) {
+void LoopCloser::globalBundleAdjustment(Map& map, int iterations, bool corrected) {
   const auto t0 = std::chrono::steady_clock::now();
   MapBaProblem whole;
   uint64_t epoch = 0;
@@ -456,14 +456,14 @@ void LoopCloser::globalBundleAdjustment(Map& map, int iterations) {
   for (size_t i = 0; i < kfs.size(); ++i) correction.before[kfs[i]] = Sim3(ba.poses[i].q_cw, ba.poses[i].t_cw, 1.0);
   BaOptions o;
   o.iterations = iterations > 0 ? iterations : settings_.global_ba_iterations;
-  o.outlier_round = false;
+  o.outliers = Outliers::Kept;
   if (settings_.global_ba_noise_factor > 0) {
     // Observations the map's own noise calls outliers sit this BA out; they stay in the map.
     // A tenth of a pixel at the least: a map fitted exactly (a test's noiseless one) would
     // otherwise call every rounding error an outlier.
     const double sigma = std::clamp(settings_.global_ba_noise_factor * medianResidualSigma(ba), 0.1, 1.0);
     setNoise(ba, sigma);
-    o.outlier_round = true;
+    o.outliers = settings_.global_ba_outliers_from_start && !corrected ? Outliers::FromStart : Outliers::SecondRound;
     stats_.global_ba_sigma = sigma;
   }
   bundleAdjust(ba, o);

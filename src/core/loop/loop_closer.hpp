@@ -68,8 +68,9 @@ class LoopCloser {
   void setOnGlobalUpdate(std::function<void(const GlobalUpdate&)> f) { on_update_ = std::move(f); }
   // A global BA of `map` with `iterations` (0: global_ba_iterations), reported as a global
   // update; the end of a run asks for one (SlamSystem::drain). On the loop closing thread, or
-  // where no other module runs; the caller holds no lock.
-  void globalBundleAdjustment(Map& map, int iterations = 0);
+  // where no other module runs; the caller holds no lock. `corrected`: a loop or merge has just
+  // moved the map, so its starting residuals do not tell outliers from a seam still open.
+  void globalBundleAdjustment(Map& map, int iterations = 0, bool corrected = false);
 
  private:
   // A recognized place with its covisibility group (keyframe ids), for the consistency test.

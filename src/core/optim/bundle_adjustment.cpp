@@ -41,15 +41,16 @@ BaSummary bundleAdjust(BaProblem& pb, const BaOptions& o) {
   ceres::Problem problem(problem_options);
   ceres::EigenQuaternionManifold quaternion;  // outlives the problem, which does not own it
   std::vector<ceres::ResidualBlockId> blocks;  // null: left out
+  const double bound = std::sqrt(5.991);
   for (const auto& ob : pb.observations) {
     auto& pose = pb.poses[static_cast<size_t>(ob.pose)];
     auto& point = pb.points[static_cast<size_t>(ob.point)];
     // A point beside or behind the camera (over 84 degrees off its axis) cannot be what the
     // keypoint saw, and near the camera plane the projection's derivatives blow up: one such
     // observation (a point 0.009 behind a new keyframe) outweighed 4,900 others, dragged the
-    // keyframe 0.29 map units off and left it with one point. It goes out as an outlier.
-    const Eigen::Vector3d pc = pose.q_cw * point.p_w + pose.t_cw;
-    if (pc.z() <= kMinCosOffAxis * pc.norm()) {
+    // keyframe 0.29 map units off and left it with one point. It goes out as an outlier
+    // (levelError is infinite there).
+    if (const double e = levelError(pb, ob); !std::isfinite(e) || (o.outliers == Outliers::FromStart && e > bound)) {
       blocks.push_back(nullptr);
       continue;
     }
@@ -70,9 +71,8 @@ BaSummary bundleAdjust(BaProblem& pb, const BaOptions& o) {
     if (point.fixed && problem.HasParameterBlock(point.p_w.data())) problem.SetParameterBlockConstant(point.p_w.data());
 
   ceres::Solver::Options options;
-  // Local windows have tens of poses: the dense Schur complement is fast there and keeps
-  // CHOLMOD (and its OpenMP threads) out of the mapping thread. Big problems go sparse.
-  options.linear_solver_type = pb.poses.size() <= 60 ? ceres::DENSE_SCHUR : ceres::SPARSE_SCHUR;
+  options.linear_solver_type = pb.poses.size() <= static_cast<size_t>(o.dense_schur_max_poses) ? ceres::DENSE_SCHUR
+                                                                                               : ceres::SPARSE_SCHUR;
   options.max_num_iterations = o.iterations;
   options.num_threads = 1;
   options.logging_type = ceres::SILENT;
@@ -86,14 +86,14 @@ BaSummary bundleAdjust(BaProblem& pb, const BaOptions& o) {
   out.iterations = static_cast<int>(summary.iterations.size());
   auto classify = [&]() {
     out.outlier.assign(pb.observations.size(), false);
-    for (size_t i = 0; i < pb.observations.size(); ++i) out.outlier[i] = levelError(pb, pb.observations[i]) > std::sqrt(5.991);
+    for (size_t i = 0; i < pb.observations.size(); ++i) out.outlier[i] = levelError(pb, pb.observations[i]) > bound;
   };
   classify();
   // Second round without the outliers: even under a robust kernel they pull the solution.
   const bool aborted = o.abort && o.abort->load();
   out.aborted = aborted;
   int removed = 0;
-  for (size_t i = 0; i < blocks.size() && !aborted && o.outlier_round; ++i)
+  for (size_t i = 0; i < blocks.size() && !aborted && o.outliers == Outliers::SecondRound; ++i)
     if (out.outlier[i] && blocks[i] && problem.NumResidualBlocks() > 1) {
       problem.RemoveResidualBlock(blocks[i]);
       ++removed;

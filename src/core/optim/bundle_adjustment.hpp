@@ -35,11 +35,27 @@ struct BaProblem {
   std::vector<BaObservation> observations;
 };
 
+// What happens to observations beyond the chi-square bound (5.991, 2 dof).
+enum class Outliers {
+  Kept,         // one round; the Huber kernel alone bounds their pull
+  SecondRound,  // optimize again without the observations the first round rejects
+  // Judged on the starting residuals and left out of the one round. For a start that is near
+  // its optimum already (a map no correction has moved), where the start tells the outliers as
+  // well as a first round would, at a third of the time (docs/BENCHMARKS.md, session 32).
+  FromStart,
+};
+
 struct BaOptions {
   int iterations = 20;
   double huber_px = 2.447;                 // sqrt(5.991): the 95% chi-square bound, 2 dof
   const std::atomic<bool>* abort = nullptr;  // checked between iterations (a new keyframe came)
-  bool outlier_round = true;  // optimize again without the observations the first round rejects
+  Outliers outliers = Outliers::SecondRound;
+  // Problems with at most this many poses factor the reduced camera system densely, bigger ones
+  // sparsely (SuiteSparse); dense also keeps CHOLMOD out of the small local windows. In the global
+  // BAs of rendered maps (91 and 140 keyframes) dense solves the linear systems 25-40% faster
+  // and the whole BA 17-26%; core_bench's BundleAdjust (a corridor, sparser) breaks even at 150
+  // poses and is 10% faster sparse at 200 (docs/BENCHMARKS.md, session 32).
+  int dense_schur_max_poses = 150;
 };
 
 struct BaSummary {
