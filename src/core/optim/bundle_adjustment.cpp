@@ -1,8 +1,10 @@
 #include "core/optim/bundle_adjustment.hpp"
 
 #include <ceres/ceres.h>
+#include <ceres/product_manifold.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include "core/optim/reprojection_error.hpp"
@@ -39,11 +41,19 @@ BaSummary bundleAdjust(BaProblem& pb, const BaOptions& o) {
   ceres::Problem::Options problem_options;
   problem_options.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
   ceres::Problem problem(problem_options);
-  ceres::EigenQuaternionManifold quaternion;  // outlives the problem, which does not own it
+  // Each pose is one 7-parameter block (quaternion coefficients x, y, z, w, then t) on a 6-dof
+  // manifold: one block per camera instead of a rotation and a translation block quarters the
+  // cells of the reduced camera system that the Schur elimination fills (and locks one by one).
+  using PoseManifold = ceres::ProductManifold<ceres::EigenQuaternionManifold, ceres::EuclideanManifold<3>>;
+  PoseManifold pose_manifold;  // outlives the problem, which does not own it
+  std::vector<std::array<double, 7>> poses(pb.poses.size());
+  for (size_t i = 0; i < pb.poses.size(); ++i) {
+    std::copy_n(pb.poses[i].q_cw.coeffs().data(), 4, poses[i].data());
+    std::copy_n(pb.poses[i].t_cw.data(), 3, poses[i].data() + 4);
+  }
   std::vector<ceres::ResidualBlockId> blocks;  // null: left out
   const double bound = std::sqrt(5.991);
   for (const auto& ob : pb.observations) {
-    auto& pose = pb.poses[static_cast<size_t>(ob.pose)];
     auto& point = pb.points[static_cast<size_t>(ob.point)];
     // A point beside or behind the camera (over 84 degrees off its axis) cannot be what the
     // keypoint saw, and near the camera plane the projection's derivatives blow up: one such
@@ -54,19 +64,22 @@ BaSummary bundleAdjust(BaProblem& pb, const BaOptions& o) {
       blocks.push_back(nullptr);
       continue;
     }
-    auto* cost = new ceres::AutoDiffCostFunction<ReprojectionError, 2, 4, 3, 3>(
-        new ReprojectionError(pb.K, ob.uv, ob.inv_sigma));
-    blocks.push_back(problem.AddResidualBlock(cost, new ceres::HuberLoss(o.huber_px), pose.q_cw.coeffs().data(),
-                                              pose.t_cw.data(), point.p_w.data()));
+    auto* cost = new ceres::AutoDiffCostFunction<ReprojectionError, 2, 7, 3>(new ReprojectionError(pb.K, ob.uv, ob.inv_sigma));
+    blocks.push_back(problem.AddResidualBlock(cost, new ceres::HuberLoss(o.huber_px),
+                                              poses[static_cast<size_t>(ob.pose)].data(), point.p_w.data()));
   }
-  for (auto& pose : pb.poses) {
-    if (!problem.HasParameterBlock(pose.q_cw.coeffs().data())) continue;
-    problem.SetManifold(pose.q_cw.coeffs().data(), &quaternion);
-    if (pose.fixed) {
-      problem.SetParameterBlockConstant(pose.q_cw.coeffs().data());
-      problem.SetParameterBlockConstant(pose.t_cw.data());
+  for (size_t i = 0; i < poses.size(); ++i) {
+    if (!problem.HasParameterBlock(poses[i].data())) continue;
+    problem.SetManifold(poses[i].data(), &pose_manifold);
+    if (pb.poses[i].fixed) problem.SetParameterBlockConstant(poses[i].data());
+  }
+  // The solution back into the problem's poses (the outlier judgement reads them).
+  auto copyBack = [&]() {
+    for (size_t i = 0; i < poses.size(); ++i) {
+      std::copy_n(poses[i].data(), 4, pb.poses[i].q_cw.coeffs().data());
+      std::copy_n(poses[i].data() + 4, 3, pb.poses[i].t_cw.data());
     }
-  }
+  };
   for (auto& point : pb.points)
     if (point.fixed && problem.HasParameterBlock(point.p_w.data())) problem.SetParameterBlockConstant(point.p_w.data());
 
@@ -80,6 +93,7 @@ BaSummary bundleAdjust(BaProblem& pb, const BaOptions& o) {
   options.callbacks.push_back(&abort);
   ceres::Solver::Summary summary;
   if (problem.NumResidualBlocks() > 0) ceres::Solve(options, &problem, &summary);
+  copyBack();
 
   BaSummary out;
   out.initial_cost = summary.initial_cost;
@@ -101,6 +115,7 @@ BaSummary bundleAdjust(BaProblem& pb, const BaOptions& o) {
   if (removed > 0) {
     options.max_num_iterations = std::max(o.iterations / 2, 5);
     ceres::Solve(options, &problem, &summary);
+    copyBack();
     out.iterations += static_cast<int>(summary.iterations.size());
     classify();
   }

@@ -53,8 +53,8 @@ struct BaOptions {
   // Problems with at most this many poses factor the reduced camera system densely, bigger ones
   // sparsely (SuiteSparse); dense also keeps CHOLMOD out of the small local windows. In the global
   // BAs of rendered maps (91 and 140 keyframes) dense solves the linear systems 25-40% faster
-  // and the whole BA 17-26%; core_bench's BundleAdjust (a corridor, sparser) breaks even at 150
-  // poses and is 10% faster sparse at 200 (docs/BENCHMARKS.md, session 32).
+  // and the whole BA 17-26%; on core_bench's BundleAdjust (a corridor, sparser) dense is 8%
+  // faster at 150 poses and sparse 10% faster at 200 (docs/BENCHMARKS.md, session 32).
   int dense_schur_max_poses = 150;
 };
 

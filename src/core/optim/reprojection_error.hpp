@@ -12,15 +12,15 @@ namespace hiveslam::core {
 struct ReprojectionError {
   ReprojectionError(const Intrinsics& K, const Eigen::Vector2d& uv, double w) : K(K), uv(uv), w(w) {}
 
-  // q: Eigen quaternion coefficients (x, y, z, w) of R_cw; t: t_cw; p: world point.
+  // pose: the Eigen quaternion coefficients (x, y, z, w) of R_cw, then t_cw; p: world point.
   template <typename T>
-  bool operator()(const T* q, const T* t, const T* p, T* r) const {
-    const T qw[4] = {q[3], q[0], q[1], q[2]};  // Ceres' order is (w, x, y, z)
+  bool operator()(const T* pose, const T* p, T* r) const {
+    const T qw[4] = {pose[3], pose[0], pose[1], pose[2]};  // Ceres' order is (w, x, y, z)
     T pc[3];
     ceres::QuaternionRotatePoint(qw, p, pc);
-    pc[0] += t[0];
-    pc[1] += t[1];
-    pc[2] += t[2];
+    pc[0] += pose[4];
+    pc[1] += pose[5];
+    pc[2] += pose[6];
     if (pc[2] <= T(1e-6)) pc[2] = T(1e-6);  // keeps the cost finite; such points are outliers
     r[0] = (T(K.fx) * pc[0] / pc[2] + T(K.cx) - T(uv.x())) * T(w);
     r[1] = (T(K.fy) * pc[1] / pc[2] + T(K.cy) - T(uv.y())) * T(w);
@@ -30,19 +30,6 @@ struct ReprojectionError {
   Intrinsics K;
   Eigen::Vector2d uv;
   double w;
-};
-
-// The same residual with the point held fixed: pose-only optimization.
-struct PoseOnlyError {
-  PoseOnlyError(const Intrinsics& K, const Eigen::Vector2d& uv, double w, const Eigen::Vector3d& p)
-      : e(K, uv, w), p(p) {}
-  template <typename T>
-  bool operator()(const T* q, const T* t, T* r) const {
-    const T pt[3] = {T(p.x()), T(p.y()), T(p.z())};
-    return e(q, t, pt, r);
-  }
-  ReprojectionError e;
-  Eigen::Vector3d p;
 };
 
 }  // namespace hiveslam::core
