@@ -38,19 +38,20 @@ class AbortCallback : public ceres::IterationCallback {
 }  // namespace
 
 BaSummary bundleAdjust(BaProblem& pb, const BaOptions& o) {
-  ceres::Problem::Options problem_options;
-  problem_options.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
-  ceres::Problem problem(problem_options);
   // Each pose is one 7-parameter block (quaternion coefficients x, y, z, w, then t) on a 6-dof
   // manifold: one block per camera instead of a rotation and a translation block quarters the
   // cells of the reduced camera system that the Schur elimination fills (and locks one by one).
+  // Both are declared before the problem, which points into them and so must go first.
   using PoseManifold = ceres::ProductManifold<ceres::EigenQuaternionManifold, ceres::EuclideanManifold<3>>;
-  PoseManifold pose_manifold;  // outlives the problem, which does not own it
+  PoseManifold pose_manifold;
   std::vector<std::array<double, 7>> poses(pb.poses.size());
   for (size_t i = 0; i < pb.poses.size(); ++i) {
     std::copy_n(pb.poses[i].q_cw.coeffs().data(), 4, poses[i].data());
     std::copy_n(pb.poses[i].t_cw.data(), 3, poses[i].data() + 4);
   }
+  ceres::Problem::Options problem_options;
+  problem_options.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+  ceres::Problem problem(problem_options);
   std::vector<ceres::ResidualBlockId> blocks;  // null: left out
   const double bound = std::sqrt(5.991);
   for (const auto& ob : pb.observations) {
