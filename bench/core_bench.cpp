@@ -1,7 +1,8 @@
-// Speed of the SLAM core's per-frame work at 752x480 with 1000 features: ORB extraction (with
-// and without sub-pixel corners), the whole frame construction (extraction + undistortion +
-// grid) and pose-only optimization (called twice per tracked frame). End-to-end tracking time
-// is `hiveslam run --realtime`'s tracking_ms (docs/BENCHMARKS.md).
+// Speed of the SLAM core: the per-frame work at 752x480 with 1000 features (ORB extraction with
+// and without sub-pixel corners, the whole frame construction, pose-only optimization, called
+// twice per tracked frame), and the mapping and loop closing solvers (bag-of-words transform,
+// Sim3 RANSAC, essential graph, bundle adjustment). End-to-end tracking time is
+// `hiveslam run --realtime`'s tracking_ms (docs/BENCHMARKS.md).
 #include <benchmark/benchmark.h>
 
 #include <opencv2/core/utility.hpp>

@@ -1,6 +1,7 @@
 #pragma once
-// The residual every optimization shares: a world point through T_cw onto the ideal pinhole
-// image, minus the undistorted keypoint, weighted by 1 / sigma of its pyramid level.
+// The residual of every bundle adjustment (initial, local, global): a world point through T_cw
+// onto the ideal pinhole image, minus the undistorted keypoint, weighted by 1 / sigma of its
+// pyramid level.
 #include <ceres/rotation.h>
 
 #include <Eigen/Core>
