@@ -1,7 +1,7 @@
 #include "core/map/keyframe.hpp"
 
 #include <algorithm>
-#include <unordered_map>
+#include <cstdint>
 
 #include "core/map/map_point.hpp"
 
@@ -52,16 +52,67 @@ std::vector<KeyFrame*> KeyFrame::bestCovisible(size_t n) const {
   return out;
 }
 
+namespace {
+
+// Shared-point counts per observing keyframe: an open-addressing table reused from call to
+// call on each thread, cleared slot by slot. updateConnections adds one count per observation
+// of every point of a keyframe (some ten thousand) into a few dozen keyframes; as a node-based
+// hash map that was half of the call.
+class ObserverCounts {
+ public:
+  void add(KeyFrame* kf) {
+    if (2 * (used_.size() + 1) > slots_.size()) grow();
+    size_t i = slotOf(kf);
+    if (!slots_[i].first) {
+      slots_[i].first = kf;
+      used_.push_back(i);
+    }
+    ++slots_[i].second;
+  }
+  template <typename F>
+  void forEach(F&& f) const {
+    for (size_t i : used_) f(slots_[i].first, slots_[i].second);
+  }
+  void clear() {
+    for (size_t i : used_) slots_[i] = {nullptr, 0};
+    used_.clear();
+  }
+
+ private:
+  size_t slotOf(const KeyFrame* kf) const {
+    const size_t mask = slots_.size() - 1;
+    // Fibonacci hashing: the product's high bits mix all of the address.
+    size_t i = static_cast<size_t>((reinterpret_cast<uintptr_t>(kf) * 0x9E3779B97F4A7C15ull) >> 40) & mask;
+    while (slots_[i].first && slots_[i].first != kf) i = (i + 1) & mask;
+    return i;
+  }
+  void grow() {
+    std::vector<std::pair<KeyFrame*, int>> old(std::max<size_t>(256, 2 * slots_.size()), {nullptr, 0});
+    old.swap(slots_);
+    std::vector<size_t> was;
+    was.swap(used_);
+    for (size_t i : was) {
+      const size_t j = slotOf(old[i].first);
+      slots_[j] = old[i];
+      used_.push_back(j);
+    }
+  }
+
+  std::vector<std::pair<KeyFrame*, int>> slots_;
+  std::vector<size_t> used_;
+};
+
+}  // namespace
+
 void KeyFrame::updateConnections() {
-  // A hash map: this runs for every keyframe of every local map a node applies, and the
-  // ordered map's insertions were most of its cost. Nothing below depends on the order (the
-  // strongest neighbour breaks ties by id).
-  std::unordered_map<KeyFrame*, int> counts;
-  counts.reserve(64);
+  // Nothing below depends on the order the counts come in: the strongest neighbour breaks
+  // ties by id, and covisibility keeps itself sorted by id.
+  thread_local ObserverCounts counts;
+  counts.clear();
   for (const auto& p : points) {
     if (!p || p->bad) continue;
     for (const auto& [kf, idx] : p->observations)
-      if (kf != this && !kf->bad) ++counts[kf];
+      if (kf != this && !kf->bad) counts.add(kf);
   }
   // Drop this keyframe from its old neighbours, then connect with weights of at least 15
   // (or the strongest one when none reaches it).
@@ -69,7 +120,7 @@ void KeyFrame::updateConnections() {
   covisibility.clear();
   KeyFrame* strongest = nullptr;
   int strongest_w = 0;
-  for (const auto& [kf, w] : counts) {
+  counts.forEach([&](KeyFrame* kf, int w) {
     if (w > strongest_w || (w == strongest_w && strongest && kf->id < strongest->id)) {
       strongest = kf;
       strongest_w = w;
@@ -78,7 +129,7 @@ void KeyFrame::updateConnections() {
       covisibility[kf] = w;
       kf->covisibility[this] = w;
     }
-  }
+  });
   if (covisibility.empty() && strongest) {
     covisibility[strongest] = strongest_w;
     strongest->covisibility[this] = strongest_w;

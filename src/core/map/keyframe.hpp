@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "core/frame/frame.hpp"
+#include "core/map/flat_map_by_id.hpp"
 #include "core/map/ids.hpp"
 #include "core/place/bow_vector.hpp"
 
@@ -35,7 +36,7 @@ class KeyFrame : public std::enable_shared_from_this<KeyFrame> {
   const Frame frame;
   Eigen::Isometry3d T_cw;
   std::vector<std::shared_ptr<MapPoint>> points;  // per keypoint, null when unmatched
-  std::map<KeyFrame*, int, ById> covisibility;          // keyframe -> shared points (>= 15 kept)
+  FlatMapById<KeyFrame, int> covisibility;  // keyframe -> shared points (>= 15 kept), by id
   KeyFrame* parent = nullptr;
   std::set<KeyFrame*, ById> children;
   bool bad = false;

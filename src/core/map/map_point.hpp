@@ -3,9 +3,9 @@
 // representative descriptor, and the viewing direction and distance range over which it can be
 // matched. Guarded by its map's mutex (see map.hpp).
 #include <Eigen/Core>
-#include <map>
 #include <opencv2/core.hpp>
 
+#include "core/map/flat_map_by_id.hpp"
 #include "core/map/ids.hpp"
 
 namespace hiveslam::core {
@@ -19,7 +19,7 @@ class MapPoint {
   const Id id;
   Eigen::Vector3d position;
   const Id first_keyframe;
-  std::map<KeyFrame*, int, ById> observations;  // keyframe -> keypoint index
+  FlatMapById<KeyFrame, int> observations;  // keyframe -> keypoint index, by keyframe id
   cv::Mat descriptor;                     // 1x32, the observation descriptor closest to the others
   Eigen::Vector3d normal = Eigen::Vector3d::Zero();  // mean viewing direction
   double min_distance = 0, max_distance = 0;         // scale-invariance range
