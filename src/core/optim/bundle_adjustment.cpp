@@ -1,7 +1,6 @@
 #include "core/optim/bundle_adjustment.hpp"
 
 #include <ceres/ceres.h>
-#include <ceres/product_manifold.h>
 
 #include <algorithm>
 #include <array>
@@ -41,9 +40,10 @@ BaSummary bundleAdjust(BaProblem& pb, const BaOptions& o) {
   // Each pose is one 7-parameter block (quaternion coefficients x, y, z, w, then t) on a 6-dof
   // manifold: one block per camera instead of a rotation and a translation block quarters the
   // cells of the reduced camera system that the Schur elimination fills (and locks one by one).
-  // Both are declared before the problem, which points into them and so must go first.
-  using PoseManifold = ceres::ProductManifold<ceres::EigenQuaternionManifold, ceres::EuclideanManifold<3>>;
+  // The manifold, the shared robust kernel and the poses are declared before the problem,
+  // which points into them and so must go first.
   PoseManifold pose_manifold;
+  ceres::HuberLoss huber(o.huber_px);
   std::vector<std::array<double, 7>> poses(pb.poses.size());
   for (size_t i = 0; i < pb.poses.size(); ++i) {
     std::copy_n(pb.poses[i].q_cw.coeffs().data(), 4, poses[i].data());
@@ -51,6 +51,7 @@ BaSummary bundleAdjust(BaProblem& pb, const BaOptions& o) {
   }
   ceres::Problem::Options problem_options;
   problem_options.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+  problem_options.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
   ceres::Problem problem(problem_options);
   std::vector<ceres::ResidualBlockId> blocks;  // null: left out
   const double bound = std::sqrt(5.991);
@@ -65,8 +66,8 @@ BaSummary bundleAdjust(BaProblem& pb, const BaOptions& o) {
       blocks.push_back(nullptr);
       continue;
     }
-    auto* cost = new ceres::AutoDiffCostFunction<ReprojectionError, 2, 7, 3>(new ReprojectionError(pb.K, ob.uv, ob.inv_sigma));
-    blocks.push_back(problem.AddResidualBlock(cost, new ceres::HuberLoss(o.huber_px),
+    auto* cost = new ReprojectionError(pb.K, ob.uv, ob.inv_sigma);
+    blocks.push_back(problem.AddResidualBlock(cost, &huber,
                                               poses[static_cast<size_t>(ob.pose)].data(), point.p_w.data()));
   }
   for (size_t i = 0; i < poses.size(); ++i) {
