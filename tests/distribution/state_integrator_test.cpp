@@ -5,6 +5,9 @@
 // On the same two-keyframe map: which keyframes a local map acknowledges as mapped.
 #include <gtest/gtest.h>
 
+#include <chrono>
+#include <thread>
+
 #include "communication/inproc/inproc_network.hpp"
 #include "core/camera/pinhole_radtan.hpp"
 #include "core/mapping/keyframe_insertion.hpp"
@@ -431,6 +434,47 @@ TEST_F(EpochLabels, ALocalMapAcknowledgesOnlyTheKeyframeMappedNotItsNeighbours) 
   receiver->stop();
 }
 
+
+// Global updates of one map can come faster than a whole map takes to send (global BAs back to
+// back on a large map). A receiver drops an update it did not get whole, so each one begun
+// must be finished: cut short for the next, none would ever arrive. Updates that are still
+// waiting meanwhile collapse into the newest.
+TEST_F(EpochLabels, GlobalMapsBegunAreFinishedWhenNewerOnesComeFasterThanTheyGoOut) {
+  communication::InProcNetwork network;
+  auto sender = network.endpoint(), receiver = network.endpoint();
+  std::mutex mutex;
+  std::map<uint64_t, std::set<uint32_t>> batches_of;  // epoch -> batches received
+  std::map<uint64_t, uint32_t> expected;
+  receiver->start({}, [](const communication::PeerInfo&, bool) {});
+  receiver->subscribe(communication::Topic::LcMap, [&](communication::Message&& m) {
+    const MapRecord r = decodeMap(unpack(m, PacketKind::Map));
+    std::lock_guard lock(mutex);
+    batches_of[r.epoch].insert(r.batch);
+    expected[r.epoch] = r.batches;
+  });
+  sender->start({}, [](const communication::PeerInfo&, bool) {});
+  SentLedger ledger;
+  DistributionSettings settings;
+  settings.global_batch = 1;          // one keyframe a batch: two batches for the two keyframes
+  settings.global_batch_gap_ms = 40;  // a whole map every 80 ms or so
+  MapHandler handler(*sender, integrator_, observer_, ledger, settings, 2, {});
+  const auto map = slam_.findMap(kMap);
+  constexpr uint64_t kUpdates = 12;
+  for (uint64_t e = 1; e <= kUpdates; ++e) {
+    handler.sendGlobal(map, e, communication::Topic::LcMap, {});
+    std::this_thread::sleep_for(std::chrono::milliseconds(25));  // three updates per whole map
+  }
+  handler.finish();
+  std::lock_guard lock(mutex);
+  ASSERT_FALSE(batches_of.empty());
+  for (const auto& [epoch, got] : batches_of) EXPECT_EQ(got.size(), expected[epoch]) << "epoch " << epoch << " cut short";
+  EXPECT_EQ(batches_of.rbegin()->first, kUpdates);  // the newest went out, whole
+  // (How many in between depends on the machine's timing: about four here, the waiting ones
+  // collapsed into newer ones.)
+  EXPECT_EQ(handler.globalMapsSent(), static_cast<int>(batches_of.size()));
+  sender->stop();
+  receiver->stop();
+}
 
 // An authoritative snapshot (LM's relay) erases what its sender no longer has, judged by the
 // ids it carries: the same objects go from the SLAM map and from S_full. Here the sender has
