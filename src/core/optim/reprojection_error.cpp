@@ -3,6 +3,8 @@
 #include <Eigen/Geometry>
 #include <cmath>
 
+#include "core/geometry/skew.hpp"
+
 namespace hiveslam::core {
 
 namespace {
@@ -10,12 +12,6 @@ namespace {
 // Below this depth the projection is evaluated at it, as a constant: the cost stays finite and
 // such points are outliers anyway (bundle adjustment leaves out those off the camera's axis).
 constexpr double kMinDepth = 1e-6;
-
-Eigen::Matrix3d skew(const Eigen::Vector3d& v) {
-  Eigen::Matrix3d m;
-  m << 0, -v.z(), v.y(), v.z(), 0, -v.x(), -v.y(), v.x(), 0;
-  return m;
-}
 
 }  // namespace
 
