@@ -28,6 +28,7 @@ TrackingOutput Tracker::track(Frame frame, bool mapping_idle) {
     if (initialize(current, out)) {
       state_ = TrackingState::Ok;
       out.tracked = true;
+      last_relocalization_frame_.reset();  // a new map: nothing relocalized in it
     }
     out.state = state_;
     return out;
@@ -43,9 +44,8 @@ TrackingOutput Tracker::track(Frame frame, bool mapping_idle) {
   bool ok = false;
   if (state_ == TrackingState::Ok) {
     ok = (have_velocity_ && trackWithMotionModel(current)) || trackReferenceKeyframe(current);
-    if (ok) ok = trackLocalMap(current, current.frame.index < last_relocalization_frame_ + 20
-                                            ? settings_.min_inliers_after_relocalization
-                                            : settings_.min_inliers_tracking);
+    if (ok) ok = trackLocalMap(current, relocalizedWithin(current.frame, 20) ? settings_.min_inliers_after_relocalization
+                                                                              : settings_.min_inliers_tracking);
     if (!ok) {
       ++failures_;
       lost_frames_ = 0;
@@ -354,7 +354,7 @@ bool Tracker::trackLocalMap(Tracked& c, int min_inliers) {
   for (KeyFrame* kf : local)
     for (const auto& p : kf->points)
       if (p && !p->bad && !matched.count(p.get()) && seen.insert(p.get()).second) candidates.push_back(p);
-  matchLocalMap(c.frame, c.T_cw, c.points, candidates, c.frame.index < last_relocalization_frame_ + 2 ? 5.0 : 1.0, scales_);
+  matchLocalMap(c.frame, c.T_cw, c.points, candidates, relocalizedWithin(c.frame, 2) ? 5.0 : 1.0, scales_);
   optimize(c);
   inliers_ = 0;
   for (size_t i = 0; i < c.points.size(); ++i)
@@ -449,7 +449,7 @@ bool Tracker::keyframeWanted(const Tracked& c) const {
 }
 
 Tracker::KeyframeDecision Tracker::keyframeDecision(const Tracked& c, bool mapping_idle) const {
-  if (c.frame.index < last_relocalization_frame_ + static_cast<size_t>(settings_.keyframe_max_frames) &&
+  if (relocalizedWithin(c.frame, static_cast<size_t>(settings_.keyframe_max_frames)) &&
       keyframes_made_ > settings_.keyframe_max_frames)
     return KeyframeDecision::None;
   if (!keyframeWanted(c)) return KeyframeDecision::None;  // also: too soon after the last one

@@ -98,7 +98,14 @@ class Tracker {
   std::vector<Eigen::Vector2d> init_prev_matched_;  // where its keypoints were last seen
   Eigen::Isometry3d velocity_ = Eigen::Isometry3d::Identity();
   bool have_velocity_ = false;
-  size_t last_keyframe_frame_ = 0, last_relocalization_frame_ = 0;
+  size_t last_keyframe_frame_ = 0;
+  // None until the tracker relocalizes: the stricter checks that follow a relocalization (a
+  // pose found by PnP against a place may be wrong) are not for a map just initialized, whose
+  // first frames on a forward-moving car hold 40-50 inliers and were dropped as lost.
+  std::optional<size_t> last_relocalization_frame_;
+  bool relocalizedWithin(const Frame& frame, size_t frames) const {
+    return last_relocalization_frame_ && frame.index < *last_relocalization_frame_ + frames;
+  }
   int lost_frames_ = 0, failures_ = 0, inliers_ = 0;
   // Keyframes this tracker made for the current map: unlike the map's own count it does not lag
   // behind a busy local mapping thread.
