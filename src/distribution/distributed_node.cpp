@@ -35,14 +35,15 @@ uint64_t firstIdCounter(std::chrono::system_clock::time_point start) {
 }  // namespace
 
 DistributedNode::DistributedNode(core::SlamSystem& slam, communication::Transport& transport, NodeOptions options)
-    : slam_(slam), transport_(transport), options_(std::move(options)), integrator_(slam, observer_) {
+    : slam_(slam), transport_(transport), options_(std::move(options)), integrator_(slam, observer_),
+      gate_(transport, std::chrono::milliseconds(options_.settings.handover_wait_ms)) {
   publisher_ = std::make_unique<KeyframePublisher>(
       transport_, observer_, ledger_, options_.id, [this](Topic topic, core::Id point) {
         // TR's receiver (LM) has every point TR received from it; LM's (LC) those sent to it.
         if (topic == Topic::TrKeyframes) return observer_.hasPoint(point);
         return ledger_.sent(Topic::LmKeyframes, point) || ledger_.sent(Topic::LmMap, point);
       },
-      [this](const core::Map& map) { return integrator_.label(map); });
+      [this](const core::Map& map) { return integrator_.label(map); }, [this](Topic t) { gate_.await(t); });
   subscriber_ = std::make_unique<KeyframeSubscriber>(
       integrator_,
       [this](const StateIntegrator::Added& a, uint8_t target) {
@@ -148,6 +149,10 @@ void DistributedNode::onPeer(const PeerInfo& peer, bool present) {
       peers_.erase(peer.node);
     }
   }
+  if (newcomer)
+    gate_.joined(peer.node, peer.task);
+  else if (!present)
+    gate_.left(peer.node);
   spdlog::info("node {}: peer {} ({}) {}", options_.id, peer.name, communication::taskName(peer.task),
                present ? (newcomer ? "joined" : "changed") : "left");
   // A global map it was sending when it died would otherwise wait here, half collected, until
@@ -473,6 +478,7 @@ void DistributedNode::stop() {
     finisher = std::move(finisher_);
   }
   if (finisher.joinable()) finisher.join();
+  gate_.stop();  // what is left goes out now: a peer that never matched is not waited for
   publisher_->finish();
   transport_.stop();
   subscriber_->finish();

@@ -28,6 +28,7 @@
 #include "distribution/keyframe_subscriber.hpp"
 #include "distribution/map_handler.hpp"
 #include "distribution/policy.hpp"
+#include "distribution/reader_gate.hpp"
 
 namespace hiveslam::distribution {
 
@@ -91,6 +92,7 @@ class DistributedNode final : public core::SystemEvents {
   Observer observer_;
   SentLedger ledger_;
   StateIntegrator integrator_;
+  ReaderGate gate_;  // keyframes wait for the readers of peers that just joined
   std::unique_ptr<KeyframePublisher> publisher_;
   std::unique_ptr<KeyframeSubscriber> subscriber_;
   std::unique_ptr<MapHandler> handler_;

@@ -11,13 +11,14 @@
 namespace hiveslam::distribution {
 
 KeyframePublisher::KeyframePublisher(communication::Transport& transport, Observer& observer, SentLedger& ledger,
-                                     uint16_t node, Known known, Label label)
+                                     uint16_t node, Known known, Label label, AwaitReaders await_readers)
     : transport_(transport),
       observer_(observer),
       ledger_(ledger),
       node_(node),
       known_(std::move(known)),
-      label_(std::move(label)) {
+      label_(std::move(label)),
+      await_readers_(std::move(await_readers)) {
   thread_ = std::thread([this] {
     nameThisThread("kf-publisher");
     loop();
@@ -46,6 +47,7 @@ void KeyframePublisher::publish(const Job& job) {
     maps_started_[job.map->id] = true;
     return;
   }
+  if (await_readers_) await_readers_(job.topic);
   if (!job.keyframe) {  // a control packet, in order after the keyframes before it
     transport_.publish(job.topic, controlPacket(node_, static_cast<Control>(job.target)));
     return;

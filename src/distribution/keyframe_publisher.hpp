@@ -32,8 +32,11 @@ class KeyframePublisher {
   // label(map), with the map's mutex held: the global epoch of the map's current frame. A
   // keyframe goes out labelled with it (StateIntegrator).
   using Label = std::function<uint64_t(const core::Map&)>;
+  // await_readers(topic): returns once the peers that joined lately read `topic` (ReaderGate);
+  // a packet published before a peer's reader has matched never reaches that peer.
+  using AwaitReaders = std::function<void(communication::Topic)>;
   KeyframePublisher(communication::Transport& transport, Observer& observer, SentLedger& ledger, uint16_t node,
-                    Known known, Label label);
+                    Known known, Label label, AwaitReaders await_readers = {});
   ~KeyframePublisher();
   void push(Job job) { queue_.push(std::move(job)); }
   // Sends what is queued, then stops the thread.
@@ -49,6 +52,7 @@ class KeyframePublisher {
   uint16_t node_;
   Known known_;
   Label label_;
+  AwaitReaders await_readers_;
   BlockingQueue<Job> queue_;
   std::atomic<int> published_{0};
   std::unordered_map<core::Id, bool> maps_started_;  // publisher thread only

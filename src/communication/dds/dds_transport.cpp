@@ -286,6 +286,11 @@ void DdsTransport::start(const PeerInfo& self, PeerHandler on_peer) {
   {
     std::lock_guard lock(d.entities);
     d.closed = false;
+    // Every topic's writer now, before any peer is heard of: its readers match during
+    // discovery. Made at its first write instead, a writer sent that packet to no one (a
+    // mapping node that returned mid-run forwarded TR's new map to LC that way, and LC never
+    // got the map; CI, session 36).
+    for (int i = 0; i < kTopicCount; ++i) d.writerFor(static_cast<Topic>(i));
   }
   d.self_node = self.node;
   {
@@ -391,7 +396,6 @@ bool DdsTransport::peerReads(Topic topic, uint16_t node) {
   {
     std::lock_guard lock(d.entities);
     if (d.closed) return false;
-    d.writerFor(topic);  // matching starts when the writer exists
   }
   std::lock_guard lock(d.match_mutex);
   return d.matched[static_cast<size_t>(topic)].count(prefix) > 0;
