@@ -57,7 +57,7 @@ DistributedNode::DistributedNode(core::SlamSystem& slam, communication::Transpor
           slam_.submit(a.map, a.keyframe, core::SlamSystem::Module::Mapping);
         }
       },
-      [this](const Message& m) { onControl(m, Topic::TrKeyframes); }, [this](core::Id id) { awaitMap(id); });
+      [this](const Message& m) { onControl(m, Topic::TrKeyframes); }, [this](core::Id id, uint8_t target) { awaitMap(id, target); });
   MapHandler::Hooks hooks;
   hooks.hold = [this](const MapRecord& m) {
     {
@@ -180,17 +180,33 @@ void DistributedNode::sendMapsTo(const PeerInfo& peer) {
   }
 }
 
-void DistributedNode::awaitMap(core::Id id) {
+void DistributedNode::awaitMap(core::Id id, uint8_t target) {
   if (slam_.findMap(id)) return;
-  const auto until = std::chrono::steady_clock::now() + std::chrono::milliseconds(options_.settings.handover_wait_ms);
+  const auto start = std::chrono::steady_clock::now();
+  const auto wait = std::chrono::milliseconds(options_.settings.handover_wait_ms);
+  // A hand-over snapshot comes within a second or so. Later than that, nobody is sending one:
+  // the packet that started the map never arrived, and the sender is asked for the map.
+  const auto ask_at = start + wait / 5;
+  bool asked = false;
   {
     std::lock_guard lock(mutex_);
     ++maps_awaited_;
   }
   spdlog::info("node {}: keyframes of map {} wait for its snapshot", options_.id, id);
   while (!slam_.findMap(id)) {
+    const auto now = std::chrono::steady_clock::now();
+    if (!asked && now >= ask_at) {
+      asked = true;
+      // Keyframes for loop closing come from the gateway, which reads LC's map topic; those for
+      // mapping come from TR, which reads the mapping node's.
+      const Topic ask_on = target == kTargetLc ? Topic::LcMap : Topic::LmMap;
+      spdlog::info("node {}: asks for map {} (the packet that started it never came)", options_.id, id);
+      transport_.publish(ask_on, controlPacket(options_.id, Control::SendMap, id));
+      std::lock_guard lock(mutex_);
+      ++maps_asked_for_;
+    }
     std::unique_lock lock(mutex_);
-    if (stopping_ || std::chrono::steady_clock::now() >= until) {
+    if (stopping_ || now >= start + wait) {
       spdlog::warn("node {}: no snapshot of map {} came; its keyframes are mapped without it", options_.id, id);
       return;
     }
@@ -413,6 +429,10 @@ void DistributedNode::onControl(const Message& m, Topic topic) {
     }
     return;
   }
+  if (c == Control::SendMap) {
+    answerMapRequest(m, topic);
+    return;
+  }
   if (c == Control::Done) {
     {
       std::lock_guard lock(mutex_);
@@ -423,6 +443,21 @@ void DistributedNode::onControl(const Message& m, Topic topic) {
     }
     changed_.notify_all();
   }
+}
+
+void DistributedNode::answerMapRequest(const Message& m, Topic topic) {
+  // Only the node that sends the asker its keyframes answers (LC, say, also reads the mapping
+  // node's map topic, where a mapping node asks TR).
+  const Plan p = plan();
+  if (!(topic == Topic::LcMap ? p.keyframes_to_lc : p.keyframes_to_lm)) return;
+  auto map = slam_.findMap(m.map);
+  if (!map || map->merged_into.load()) {
+    spdlog::info("node {}: node {} asked for map {}, which is not held here", options_.id, m.source, m.map);
+    return;
+  }
+  spdlog::info("node {}: node {} asked for map {}", options_.id, m.source, m.map);
+  std::lock_guard lock(mutex_);
+  handler_->sendGlobal(map, synced_[map->id], Topic::LmMap, {}, true, {m.source, {Topic::LmMap}});
 }
 
 void DistributedNode::finishAsGateway() {
@@ -554,6 +589,7 @@ nlohmann::json DistributedNode::report(double seconds) const {
     j["globals_ignored"] = globals_ignored_;
     j["local_maps_held"] = local_maps_held_;
     j["maps_awaited"] = maps_awaited_;
+    j["maps_asked_for"] = maps_asked_for_;
     j["keyframes_taken_back"] = keyframes_taken_back_;
     j["stale_points_carried"] = integrator_.stalePointsCarried();
     j["peers"] = peers_.size();

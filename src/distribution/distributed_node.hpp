@@ -11,6 +11,10 @@
 // Hand-over: a node that joins the network gets the maps so far as a full snapshot, from the
 // gateway (a late LC) or from the node that mapped until it came (an LM that joins or returns
 // after TR took mapping back). Its keyframes of those maps wait for the snapshot.
+//
+// Lost map: a node that gets keyframes of a map it does not hold, with no snapshot coming (the
+// packet that started the map was lost), asks the node that sends it keyframes for the map
+// (Control::SendMap) and gets the same snapshot a newcomer would.
 #include <atomic>
 #include <chrono>
 #include <condition_variable>
@@ -81,7 +85,10 @@ class DistributedNode final : public core::SystemEvents {
   void sendMapsTo(const communication::PeerInfo& peer);
   // Subscriber thread: until map `id` is held here, a new node's start-up is over, or the
   // node stops (handover_wait_ms at most).
-  void awaitMap(core::Id id);
+  // `target`: the module the waiting keyframe is for. Asks for the map when no snapshot comes.
+  void awaitMap(core::Id id, uint8_t target);
+  // Control::SendMap: a snapshot of the map for the node that asked, if this node feeds it.
+  void answerMapRequest(const communication::Message& m, communication::Topic topic);
   bool remoteIdle() const;
   void remoteWait() const;
   communication::PeerInfo self() const;
@@ -117,6 +124,7 @@ class DistributedNode final : public core::SystemEvents {
   int local_maps_held_ = 0;  // local maps that came ahead of their global update
   uint64_t incarnation_ = 0;
   int maps_awaited_ = 0;  // keyframes that waited for a hand-over
+  int maps_asked_for_ = 0;  // of those, the ones whose map was asked for (Control::SendMap)
   int keyframes_taken_back_ = 0;  // unacknowledged keyframes mapped here after the LM left
   uint64_t knownEpoch(core::Id map) const;  // the newer of synced_ and published_; mutex_ held
   void releaseHeld(core::Id map);           // applies the held local maps the epoch has reached

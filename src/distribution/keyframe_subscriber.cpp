@@ -31,7 +31,7 @@ void KeyframeSubscriber::loop() {
     try {
       const KeyFrameMessage k = decodeKeyframe(unpack(*m, PacketKind::Keyframe));
       ++received_;
-      if (k.companions.empty() && await_map_) await_map_(k.keyframe.map);
+      if (k.companions.empty() && await_map_) await_map_(k.keyframe.map, m->target);
       auto added = integrator_.addKeyframe(k, m->epoch);
       if (added.keyframe) route_(added, m->target);
     } catch (const std::exception& e) {

@@ -3,7 +3,8 @@
 // decoded, put into its map (StateIntegrator) and handed to the module it targets. A malformed
 // message is logged and dropped. A keyframe of a map this node does not hold, and that is not
 // a new map's (no companions), waits for the map first (AwaitMap): the node took its task over
-// and the maps so far are on their way from the node that held them.
+// and the maps so far are on their way from the node that held them, or the packet that
+// started the map was lost and the map must be asked for.
 #include <functional>
 #include <thread>
 
@@ -17,8 +18,9 @@ class KeyframeSubscriber {
  public:
   using Route = std::function<void(const StateIntegrator::Added&, uint8_t target)>;
   using OnControl = std::function<void(const communication::Message&)>;
-  // Returns once the map is held here or waiting longer makes no sense.
-  using AwaitMap = std::function<void(Id map)>;
+  // Returns once the map is held here or waiting longer makes no sense. `target`: the
+  // module the keyframe is for (which tells whom to ask for the map).
+  using AwaitMap = std::function<void(Id map, uint8_t target)>;
   KeyframeSubscriber(StateIntegrator& integrator, Route route, OnControl control, AwaitMap await_map = {});
   ~KeyframeSubscriber();
   void push(communication::Message&& m) { queue_.push(std::move(m)); }

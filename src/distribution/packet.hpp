@@ -21,12 +21,13 @@ communication::Message pack(const Record& record, uint16_t source, uint8_t targe
   return m;
 }
 
-// A control packet: header only, the command in the target field.
-inline communication::Message controlPacket(uint16_t source, Control command) {
+// A control packet: header only, the command in the target field (and the map it is about).
+inline communication::Message controlPacket(uint16_t source, Control command, uint64_t map = 0) {
   communication::Message m;
   m.source = source;
   m.kind = static_cast<uint8_t>(PacketKind::Control);
   m.target = static_cast<uint8_t>(command);
+  m.map = map;
   return m;
 }
 

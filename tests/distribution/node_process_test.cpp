@@ -271,7 +271,7 @@ RestartRun runWithARestart(const fs::path& out, const std::string& task, int dom
 TEST(NodeProcesses, ARestartedMappingNodeTakesTheMapOverFromTracking) {
   testing::TempDir out;
   const auto [status, tr, lm2, lc] = runWithARestart(out.path(), "lm", 200 + getpid() % 30);
-  ASSERT_EQ(status, 0) << std::ifstream(out / "tr.log").rdbuf();
+  ASSERT_EQ(status, 0) << nodeEvents(out.path());
   EXPECT_EQ(tasks(tr), std::vector<std::string>{"tr"}) << tr.dump();
   EXPECT_EQ(lm2.value("end_of_run", ""), "completed") << std::ifstream(out / "lm2.log").rdbuf();
   EXPECT_GT(tr["mapping"]["keyframes_processed"].get<int>(), 0);   // TR mapped during the outage
@@ -290,7 +290,7 @@ TEST(NodeProcesses, ARestartedMappingNodeTakesTheMapOverFromTracking) {
 TEST(NodeProcesses, ARestartedLoopClosingNodeTakesTheWholeMapFromTheGateway) {
   testing::TempDir out;
   const auto [status, tr, lm, lc2] = runWithARestart(out.path(), "lc", 50 + getpid() % 50);
-  ASSERT_EQ(status, 0) << std::ifstream(out / "tr.log").rdbuf();
+  ASSERT_EQ(status, 0) << nodeEvents(out.path());
   EXPECT_EQ(tasks(tr), std::vector<std::string>{"tr"}) << tr.dump();
   EXPECT_EQ(tasks(lm), std::vector<std::string>{"lm"}) << std::ifstream(out / "lm.log").rdbuf();
   EXPECT_EQ(lm.value("end_of_run", ""), "completed");
@@ -306,7 +306,7 @@ TEST(NodeProcesses, ARestartedLoopClosingNodeTakesTheWholeMapFromTheGateway) {
 TEST(NodeProcesses, ARestartedTrackingNodeGetsTheMapAndEndsWithOneMap) {
   testing::TempDir out;
   const auto [status, tr2, lm, lc] = runWithARestart(out.path(), "tr", 10 + getpid() % 40);
-  ASSERT_EQ(status, 0) << std::ifstream(out / "tr2.log").rdbuf();
+  ASSERT_EQ(status, 0) << nodeEvents(out.path());
   EXPECT_EQ(tasks(tr2), std::vector<std::string>{"tr"}) << tr2.dump();
   EXPECT_EQ(lm.value("end_of_run", ""), "completed") << std::ifstream(out / "lm.log").rdbuf();
   EXPECT_EQ(lc.value("end_of_run", ""), "completed") << std::ifstream(out / "lc.log").rdbuf();

@@ -68,10 +68,19 @@ void InProcNetwork::leave(const std::shared_ptr<Member>& m) {
     if (handler) handler(info, false);
 }
 
+void InProcNetwork::loseNext(Topic topic, int count) {
+  std::lock_guard lock(mutex_);
+  to_lose_[static_cast<size_t>(topic)] += count;
+}
+
 void InProcNetwork::deliver(const Member* from, Topic topic, const Message& message) {
   std::vector<std::pair<std::shared_ptr<Transport::Handler>, Member*>> targets;
   {
     std::lock_guard lock(mutex_);
+    if (int& lose = to_lose_[static_cast<size_t>(topic)]; lose > 0) {
+      --lose;
+      return;
+    }
     for (const auto& m : members_) {
       if (m.get() == from) continue;
       std::lock_guard l(m->mutex);

@@ -2,6 +2,7 @@
 // An in-process network: endpoints that behave like DDS participants on one domain (peers
 // discovered on start, gone on stop, packets delivered to subscribed endpoints only, in order
 // per publisher and topic) without sockets. Unit tests run several nodes in one process on it.
+#include <array>
 #include <memory>
 #include <mutex>
 #include <vector>
@@ -16,6 +17,9 @@ class InProcNetwork {
  public:
   // A new endpoint on this network (the network must outlive it).
   std::unique_ptr<InProcTransport> endpoint();
+  // Tests: the next `count` packets published on `topic` reach no one, as packets written
+  // before a new peer's reader matched never reach it over DDS.
+  void loseNext(Topic topic, int count = 1);
 
  private:
   friend class InProcTransport;
@@ -27,6 +31,7 @@ class InProcNetwork {
   bool reads(uint16_t node, Topic topic);
   std::mutex mutex_;
   std::vector<std::shared_ptr<Member>> members_;
+  std::array<int, kTopicCount> to_lose_{};
 };
 
 class InProcTransport final : public Transport {

@@ -14,6 +14,9 @@ enum class PacketKind : uint8_t { Keyframe = 1, Map = 2, Control = 3 };
 enum class Control : uint8_t {
   EndOfSequence = 1,  // TR -> LM -> LC: no keyframe after this one
   Done = 2,           // LC -> LM, then LM -> all: everything is sent; LM's last snapshot precedes it
+  // A node holds keyframes of a map it never got (the packet that started the map was lost):
+  // the node that sends it keyframes answers with a snapshot of the map (the packet's `map`).
+  SendMap = 3,        // LC -> LM on LC's map topic, LM -> TR on LM's
 };
 // Raised with every change of the encoding, so that a node of another build drops what it
 // cannot read with a warning instead of misreading it. 2: map records carry `update`.
