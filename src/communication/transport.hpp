@@ -29,7 +29,8 @@ class Transport {
   // Announces a change of this node (hosted tasks, load).
   virtual void announce(const PeerInfo& self) = 0;
   virtual void publish(Topic topic, Message&& message) = 0;
-  // Only subscribed topics reach this node (and count against its bandwidth).
+  // Only subscribed topics reach this node (and count against its bandwidth). Ignored before
+  // start() and once stop() has begun.
   virtual void subscribe(Topic topic, Handler handler) = 0;
   virtual void unsubscribe(Topic topic) = 0;
   // Whether peer `node` reads `topic` from this node now (its reader has matched): what is

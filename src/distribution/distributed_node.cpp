@@ -136,10 +136,11 @@ Plan DistributedNode::plan() const {
 }
 
 void DistributedNode::onPeer(const PeerInfo& peer, bool present) {
-  bool newcomer = false, restarted = false;
+  bool newcomer = false, restarted = false, leaving = false;
   const Plan before = plan();
   {
     std::lock_guard lock(mutex_);
+    leaving = stopping_;
     if (present) {
       auto it = peers_.find(peer.node);
       newcomer = it == peers_.end() || it->second.incarnation != peer.incarnation;
@@ -160,6 +161,7 @@ void DistributedNode::onPeer(const PeerInfo& peer, bool present) {
   if (!present || restarted)
     if (const size_t dropped = observer_.dropPendingGlobals(peer.node))
       spdlog::info("node {}: {} batches of an unfinished global map from {} dropped", options_.id, dropped, peer.name);
+  if (leaving) return;  // no task is taken over or handed on while the transport goes down
   applyPlan();
   // A node that joins late gets the maps so far from the gateway; a mapping node that joins
   // (or returns) gets them from the node that mapped until now, which gives mapping up to it.

@@ -358,6 +358,10 @@ void DdsTransport::publish(Topic topic, Message&& m) {
 void DdsTransport::subscribe(Topic topic, Handler handler) {
   Impl& d = *impl_;
   std::lock_guard lock(d.entities);
+  // Stopping (or not started): a peer event handled during stop() subscribes as the node takes
+  // a task back, and a reader made then went into a subscriber being deleted (session 36: a TR
+  // once never finished when the returning LM left at the very end of the run).
+  if (d.closed) return;
   auto& r = d.readers[static_cast<size_t>(topic)];
   if (r) return;  // one handler per topic for the life of the reader
   r = std::make_unique<Impl::Reader>();

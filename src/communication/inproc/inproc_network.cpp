@@ -136,6 +136,7 @@ void InProcTransport::publish(Topic topic, Message&& message) {
 
 void InProcTransport::subscribe(Topic topic, Handler handler) {
   std::lock_guard lock(member_->mutex);
+  if (!member_->joined) return;  // not started, or stopped (as DdsTransport)
   member_->handlers[static_cast<size_t>(topic)] = std::make_shared<Handler>(std::move(handler));
 }
 
