@@ -177,9 +177,13 @@ void DistributedNode::sendMapsTo(const PeerInfo& peer) {
   if (p.keyframes_to_lc && peer.task == Task::LoopClosing) newcomer.reads.push_back(Topic::LmKeyframes);
   for (const auto& map : slam_.liveMaps()) {
     publisher_->push({map, nullptr, Topic::TrKeyframes, 0, true});
-    std::lock_guard lock(mutex_);
-    handler_->sendGlobal(map, synced_[map->id], Topic::LmMap, {}, true, newcomer);
+    sendSnapshot(map, newcomer);
   }
+}
+
+void DistributedNode::sendSnapshot(const std::shared_ptr<core::Map>& map, Newcomer newcomer) {
+  std::lock_guard lock(mutex_);
+  handler_->sendGlobal(map, synced_[map->id], Topic::LmMap, {}, true, std::move(newcomer));
 }
 
 void DistributedNode::awaitMap(core::Id id, uint8_t target) {
@@ -197,17 +201,17 @@ void DistributedNode::awaitMap(core::Id id, uint8_t target) {
   spdlog::info("node {}: keyframes of map {} wait for its snapshot", options_.id, id);
   while (!slam_.findMap(id)) {
     const auto now = std::chrono::steady_clock::now();
-    if (!asked && now >= ask_at) {
+    const bool ask = !asked && now >= ask_at;
+    if (ask) {
       asked = true;
       // Keyframes for loop closing come from the gateway, which reads LC's map topic; those for
       // mapping come from TR, which reads the mapping node's.
       const Topic ask_on = target == kTargetLc ? Topic::LcMap : Topic::LmMap;
       spdlog::info("node {}: asks for map {} (the packet that started it never came)", options_.id, id);
       transport_.publish(ask_on, controlPacket(options_.id, Control::SendMap, id));
-      std::lock_guard lock(mutex_);
-      ++maps_asked_for_;
     }
     std::unique_lock lock(mutex_);
+    maps_asked_for_ += ask;
     if (stopping_ || now >= start + wait) {
       spdlog::warn("node {}: no snapshot of map {} came; its keyframes are mapped without it", options_.id, id);
       return;
@@ -458,8 +462,7 @@ void DistributedNode::answerMapRequest(const Message& m, Topic topic) {
     return;
   }
   spdlog::info("node {}: node {} asked for map {}", options_.id, m.source, m.map);
-  std::lock_guard lock(mutex_);
-  handler_->sendGlobal(map, synced_[map->id], Topic::LmMap, {}, true, {m.source, {Topic::LmMap}});
+  sendSnapshot(map, {m.source, {Topic::LmMap}});
 }
 
 void DistributedNode::finishAsGateway() {

@@ -83,6 +83,9 @@ class DistributedNode final : public core::SystemEvents {
   void finishAsGateway();
   // A newcomer gets this node's maps so far (see Hand-over above).
   void sendMapsTo(const communication::PeerInfo& peer);
+  // A full snapshot of `map` with its keyframes' features, for `newcomer` (a hand-over, or a
+  // node that asked for a map it missed).
+  void sendSnapshot(const std::shared_ptr<core::Map>& map, Newcomer newcomer);
   // Subscriber thread: until map `id` is held here, a new node's start-up is over, or the
   // node stops (handover_wait_ms at most).
   // `target`: the module the waiting keyframe is for. Asks for the map when no snapshot comes.
