@@ -218,6 +218,7 @@ struct DdsTransport::Impl : public dds::DomainParticipantListener {
     q.history().depth = options.history_depth;
     q.durability().kind = dds::VOLATILE_DURABILITY_QOS;
     q.publish_mode().kind = dds::ASYNCHRONOUS_PUBLISH_MODE;  // large packets are sent off-thread
+  q.reliable_writer_qos().times.heartbeatPeriod = Duration_t(options.heartbeat_ms / 1000.0);
     auto& listener = writer_listeners[static_cast<size_t>(t)];
     listener.impl = this;
     listener.topic = static_cast<size_t>(t);
@@ -259,7 +260,9 @@ void DdsTransport::start(const PeerInfo& self, PeerHandler on_peer) {
   // PR 4728, after 2.9). Nodes on separate devices talk UDP anyway, and a node sends a few
   // Mbps at most.
   pq.transport().use_builtin_transports = false;
-  pq.transport().user_transports.push_back(std::make_shared<eprosima::fastdds::rtps::UDPv4TransportDescriptor>());
+  auto udp = std::make_shared<eprosima::fastdds::rtps::UDPv4TransportDescriptor>();
+  udp->maxMessageSize = static_cast<uint32_t>(d.options.max_datagram_bytes);
+  pq.transport().user_transports.push_back(udp);
   d.participant = dds::DomainParticipantFactory::get_instance()->create_participant(
       static_cast<dds::DomainId_t>(d.options.domain), pq, &d, dds::StatusMask::none());
   if (!d.participant) throw InputError("DDS: cannot create a participant on domain " + std::to_string(d.options.domain));
