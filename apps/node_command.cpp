@@ -44,7 +44,9 @@ void serve(const NodeCommandOptions& o, communication::Task task) {
   const auto vocabulary = io::loadVocabulary(settings);
   const uint16_t id = o.id > 0 ? static_cast<uint16_t>(o.id) : defaultId(task);
   core::SlamSystem slam(settings, nullptr, core::SlamSystem::Mode::Offline, vocabulary, id);
-  communication::DdsTransport transport({o.domain});
+  communication::DdsOptions dds{o.domain};
+  if (!o.config.empty()) io::applyDdsSettings(o.config, dds);
+  communication::DdsTransport transport(dds);
   distribution::DistributionSettings distribution_settings;
   if (!o.config.empty()) io::applyDistributionSettings(o.config, distribution_settings);
   distribution::DistributedNode node(

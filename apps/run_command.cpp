@@ -108,7 +108,9 @@ RunSummary runSlam(const RunOptions& o) {
   if (o.network.enabled) {
     distribution::DistributionSettings distribution_settings;
     if (!o.config.empty()) io::applyDistributionSettings(o.config, distribution_settings);
-    transport = std::make_unique<communication::DdsTransport>(communication::DdsOptions{o.network.domain});
+    communication::DdsOptions dds{o.network.domain};
+    if (!o.config.empty()) io::applyDdsSettings(o.config, dds);
+    transport = std::make_unique<communication::DdsTransport>(dds);
     node = std::make_unique<distribution::DistributedNode>(
         slam, *transport,
         distribution::NodeOptions{communication::Task::Tracking, o.network.id, o.network.name, distribution_settings});
@@ -287,7 +289,7 @@ void addRunCommand(CLI::App& app) {
   cmd->add_option("--calibration", o->calibration, "With --topic: camera file (settings YAML, sensor.yaml or calib.txt)");
   cmd->add_option("--domain", o->topic_domain, "With --topic: DDS domain id (the ROS_DOMAIN_ID)")->capture_default_str();
   cmd->add_option("--ground-truth", o->ground_truth, "Score against this dataset's ground truth (for --topic)");
-  cmd->add_option("--config", o->config, "Settings YAML: its camera section replaces the dataset's calibration, its slam and distribution sections override the defaults");
+  cmd->add_option("--config", o->config, "Settings YAML: its camera section replaces the dataset's calibration, its slam, distribution and dds sections override the defaults");
   cmd->add_option("--times", o->times, "Times file for image folders and videos");
   cmd->add_option("--out", o->out, "Output folder")->required();
   cmd->add_flag("--sequential", o->sequential, "Lockstep tracking and mapping on one thread (deterministic)");

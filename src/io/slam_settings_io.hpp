@@ -1,6 +1,7 @@
 #pragma once
 #include <filesystem>
 
+#include "communication/dds/dds_options.hpp"
 #include "core/system/slam_settings.hpp"
 #include "distribution/distribution_settings.hpp"
 
@@ -14,5 +15,9 @@ void applySlamSettings(const std::filesystem::path& file, core::SlamSettings& se
 // Applies the `distribution:` section (keys as in DistributionSettings), checked the same way
 // and for ranges.
 void applyDistributionSettings(const std::filesystem::path& file, distribution::DistributionSettings& settings);
+
+// Applies the `dds:` section (max_datagram_bytes, heartbeat_ms, history_depth), checked the
+// same way and for ranges. The domain comes from the command line.
+void applyDdsSettings(const std::filesystem::path& file, communication::DdsOptions& options);
 
 }  // namespace hiveslam::io

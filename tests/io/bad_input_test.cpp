@@ -204,6 +204,26 @@ TEST(BadInput, DistributionSettingsAreReadAndChecked) {
   EXPECT_NE(errorOf([&] { applyDistributionSettings(file, s); }).find("wrong type"), std::string::npos);
 }
 
+TEST(BadInput, DdsSettingsAreReadAndChecked) {
+  testing::TempDir dir;
+  const fs::path file = dir / "settings.yaml";
+  std::ofstream(file) << "dds:\n  max_datagram_bytes: 8972\n  heartbeat_ms: 50\n";
+  communication::DdsOptions o{12};
+  applyDdsSettings(file, o);
+  EXPECT_EQ(o.max_datagram_bytes, 8972);
+  EXPECT_EQ(o.heartbeat_ms, 50);
+  EXPECT_EQ(o.domain, 12);        // the command line's
+  EXPECT_EQ(o.history_depth, 64);  // untouched keys keep their defaults
+  std::ofstream(file) << "dds:\n  domain: 3\n";
+  EXPECT_NE(errorOf([&] { applyDdsSettings(file, o); }).find("unknown setting 'dds.domain'"), std::string::npos);
+  std::ofstream(file) << "dds:\n  max_datagram_bytes: 100000\n";
+  EXPECT_NE(errorOf([&] { applyDdsSettings(file, o); }).find("max_datagram_bytes 576-65500"), std::string::npos);
+  std::ofstream(file) << "dds:\n  heartbeat_ms: 0\n";
+  EXPECT_NE(errorOf([&] { applyDdsSettings(file, o); }).find("out of range"), std::string::npos);
+  std::ofstream(file) << "dds:\n  heartbeat_ms: fast\n";
+  EXPECT_NE(errorOf([&] { applyDdsSettings(file, o); }).find("wrong type"), std::string::npos);
+}
+
 TEST(BadInput, ACameraFileIsRecognisedByItsContent) {
   testing::TempDir dir;
   const fs::path seq = makeSequence(dir);

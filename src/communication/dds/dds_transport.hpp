@@ -6,22 +6,10 @@
 // (2 s) is reported gone.
 #include <memory>
 
+#include "communication/dds/dds_options.hpp"
 #include "communication/transport.hpp"
 
 namespace hiveslam::communication {
-
-struct DdsOptions {
-  int domain = 0;
-  int history_depth = 64;  // packets kept per writer for late acknowledgements
-  // UDP datagrams no larger than an Ethernet frame's payload: a 64 KB datagram is ~45 IP
-  // fragments, and one lost fragment loses all of it (at 2% packet loss, a keyframe message got
-  // through whole less than half the time). MTU-sized datagrams are RTPS fragments that a
-  // reader asks for again one by one.
-  int max_datagram_bytes = 1400;
-  // How often a reliable writer with unacknowledged packets says what it has sent, so that a
-  // reader notices a lost last fragment (Fast DDS's default is 3 s).
-  int heartbeat_ms = 100;
-};
 
 class DdsTransport final : public Transport {
  public:

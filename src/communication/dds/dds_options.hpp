@@ -1,0 +1,19 @@
+#pragma once
+// What a node's DDS participant is made with; the `dds:` section of a settings file overrides
+// all but the domain (io/slam_settings_io.hpp).
+namespace hiveslam::communication {
+
+struct DdsOptions {
+  int domain = 0;  // the ROS_DOMAIN_ID; set by --domain
+  int history_depth = 64;  // packets kept per writer for late acknowledgements
+  // UDP datagrams no larger than an Ethernet frame's payload: a 64 KB datagram is ~45 IP
+  // fragments, and one lost fragment loses all of it (at 2% packet loss, a keyframe message got
+  // through whole less than half the time). MTU-sized datagrams are RTPS fragments that a
+  // reader asks for again one by one.
+  int max_datagram_bytes = 1400;
+  // How often a reliable writer with unacknowledged packets says what it has sent, so that a
+  // reader notices a lost last fragment (Fast DDS's default is 3 s).
+  int heartbeat_ms = 100;
+};
+
+}  // namespace hiveslam::communication
