@@ -4,7 +4,7 @@
 namespace hiveslam::communication {
 
 struct DdsOptions {
-  int domain = 0;  // the ROS_DOMAIN_ID; set by --domain
+  int domain = 0;          // the ROS_DOMAIN_ID; set by --domain
   int history_depth = 64;  // packets kept per writer for late acknowledgements
   // UDP datagrams no larger than an Ethernet frame's payload: a 64 KB datagram is ~45 IP
   // fragments, and one lost fragment loses all of it (at 2% packet loss, a keyframe message got

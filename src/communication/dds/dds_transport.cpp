@@ -218,7 +218,7 @@ struct DdsTransport::Impl : public dds::DomainParticipantListener {
     q.history().depth = options.history_depth;
     q.durability().kind = dds::VOLATILE_DURABILITY_QOS;
     q.publish_mode().kind = dds::ASYNCHRONOUS_PUBLISH_MODE;  // large packets are sent off-thread
-  q.reliable_writer_qos().times.heartbeatPeriod = Duration_t(options.heartbeat_ms / 1000.0);
+    q.reliable_writer_qos().times.heartbeatPeriod = Duration_t(options.heartbeat_ms / 1000.0);
     auto& listener = writer_listeners[static_cast<size_t>(t)];
     listener.impl = this;
     listener.topic = static_cast<size_t>(t);
