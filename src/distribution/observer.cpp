@@ -58,7 +58,8 @@ void Observer::eraseKeyframe(Id id) {
 }
 
 void Observer::prune(const MapRecord& snapshot, const std::unordered_set<Id>& keyframes,
-                     const std::unordered_set<Id>& points, const std::function<bool(Id)>& known_to_sender) {
+                     const std::unordered_set<Id>& points, const std::function<bool(Id)>& keyframe_known,
+                     const std::function<bool(Id)>& point_known) {
   std::lock_guard lock(mutex_);
   std::unordered_set<Id> maps(snapshot.merged_maps.begin(), snapshot.merged_maps.end());
   maps.insert(snapshot.map);
@@ -69,14 +70,14 @@ void Observer::prune(const MapRecord& snapshot, const std::unordered_set<Id>& ke
     return m == point_map_.end() || maps.count(m->second) > 0;
   };
   for (auto it = keyframes_.begin(); it != keyframes_.end();)
-    if (maps.count(it->second.map) && !keyframes.count(it->first) && known_to_sender(it->first)) {
+    if (maps.count(it->second.map) && !keyframes.count(it->first) && keyframe_known(it->first)) {
       erased_keyframes_.insert(it->first);
       it = keyframes_.erase(it);
     } else {
       ++it;
     }
   for (auto it = points_.begin(); it != points_.end();)
-    if (!points.count(it->first) && known_to_sender(it->first) && of_snapshot(it->first)) {
+    if (!points.count(it->first) && point_known(it->first) && of_snapshot(it->first)) {
       erased_points_.insert(it->first);
       point_map_.erase(it->first);
       it = points_.erase(it);

@@ -30,10 +30,10 @@ class Observer {
   void record(const MapRecord& m);
   void eraseKeyframe(Id id);
   // After an authoritative snapshot of `snapshot.map`: records of that map (or of the maps it
-  // absorbed) that the snapshot lacks and that `known` says its sender had go (the sender
-  // erased them). Another map's records are not the snapshot's to judge.
+  // absorbed) that the snapshot lacks and that `keyframe_known` / `point_known` say its sender
+  // had go (the sender erased them). Another map's records are not the snapshot's to judge.
   void prune(const MapRecord& snapshot, const std::unordered_set<Id>& keyframes, const std::unordered_set<Id>& points,
-             const std::function<bool(Id)>& known_to_sender);
+             const std::function<bool(Id)>& keyframe_known, const std::function<bool(Id)>& point_known);
   void erasePoint(Id id);
   // Whether the point was erased here (a tombstone: a record from a node that has not heard of
   // the erasure yet must not bring it back).

@@ -500,27 +500,33 @@ bool StateIntegrator::applyGlobal(const std::vector<MapRecord>& batches, bool au
   if (authoritative) {
     // What the sender no longer has (culled or fused while this node was not listening) goes,
     // except what it could not have known yet when it took the snapshot. One rule for the map
-    // and for S_full: keyframes and points share each node's id counter, so an object older
-    // than anything of its node in the snapshot was known to the sender. (The map once judged
-    // points by the snapshot's points alone, S_full by both: a point both rules did not agree
-    // on stayed in the SLAM map only, and LC ended a CI run with one point more than LM.)
+    // and for S_full. (The map once judged points by the snapshot's points alone, S_full by
+    // both: a point both rules did not agree on stayed in the SLAM map only, and LC ended a
+    // CI run with one point more than LM.)
+    // - A keyframe was known to the sender if the snapshot holds a newer keyframe of its node:
+    //   each node's keyframes reach the sender in order, one by one through its mapping queue.
+    // - A point, if the snapshot holds a newer object of its node (points and keyframes share
+    //   each node's id counter, and points come with or after the keyframe that made them).
+    //   Judged by this rule, a keyframe was erased when the snapshot held only the points its
+    //   predecessor brought, newer than it (a new map's second keyframe).
     std::vector<Id> ids = kf_ids;
     ids.insert(ids.end(), point_ids.begin(), point_ids.end());
-    const auto newest = newestByNode(ids);
-    const auto known_to_sender = [&](Id id) { return olderThanSnapshot(id, newest); };
+    const auto newest = newestByNode(ids), newest_keyframe = newestByNode(kf_ids);
+    const auto keyframe_known = [&](Id id) { return olderThanSnapshot(id, newest_keyframe); };
+    const auto point_known = [&](Id id) { return olderThanSnapshot(id, newest); };
     const std::unordered_set<Id> kfs(kf_ids.begin(), kf_ids.end()), pts(point_ids.begin(), point_ids.end());
     std::vector<core::KeyFrame*> gone_kfs;
     for (const auto& [id, k] : map->keyframes)
-      if (!kfs.count(id) && known_to_sender(id) && k.get() != map->origin) gone_kfs.push_back(k.get());
+      if (!kfs.count(id) && keyframe_known(id) && k.get() != map->origin) gone_kfs.push_back(k.get());
     for (core::KeyFrame* k : gone_kfs) {
       map->erase(*k);
       slam_.database().erase(k);
     }
     std::vector<core::MapPoint*> gone_points;
     for (const auto& [id, p] : map->points)
-      if (!pts.count(id) && known_to_sender(id)) gone_points.push_back(p.get());
+      if (!pts.count(id) && point_known(id)) gone_points.push_back(p.get());
     for (core::MapPoint* p : gone_points) map->erase(*p);
-    observer_.prune(batches.front(), kfs, pts, known_to_sender);
+    observer_.prune(batches.front(), kfs, pts, keyframe_known, point_known);
   }
   for (const auto& [id, k] : map->keyframes) k->updateConnections();
   noteEpoch(*map, epoch);

@@ -219,9 +219,54 @@ struct RestartRun {
   nlohmann::json tr, lm, lc;
 };
 
+// What each node's report and frame log say in brief: its map, its loops and merges (where,
+// at what scale), the stretches of frames it tracked in each map, and every 20th estimated
+// position. A failed accuracy check is read from this in CI, where the folder is gone.
+std::string nodeDigest(const fs::path& node) {
+  std::ostringstream o;
+  std::ifstream in(node / "report.json");
+  if (!in) return "";
+  const auto r = nlohmann::json::parse(in, nullptr, false);
+  if (r.is_discarded()) return "";
+  o << "=== " << node.filename().string() << ": keyframes " << r.value("keyframes", -1) << ", points "
+    << r.value("map_points", -1) << ", maps " << r.value("maps", -1);
+  if (r.contains("tracked_frames")) o << ", tracked " << r.value("tracked_frames", -1);
+  if (r.contains("ate")) o << ", ATE " << r["ate"].value("percent_of_path", -1.0) << "% (max " << r["ate"].value("max", -1.0) << " m)";
+  o << "\n";
+  for (const auto& e : r.value("loop_events", nlohmann::json::array()))
+    o << "  " << e.value("kind", "") << " at " << e.value("timestamp", 0.0) << " to " << e.value("place_timestamp", 0.0)
+      << ": " << e.value("matches", 0) << " matches, scale " << e.value("scale", 0.0) << "\n";
+  std::ifstream frames(node / "frames.csv");
+  std::string line, last_map, first;
+  std::getline(frames, line);  // the header
+  int run = 0;
+  auto flush = [&] {
+    if (run > 0) o << "  frames from " << first << ": " << run << " in map " << last_map << "\n";
+  };
+  while (std::getline(frames, line)) {
+    std::vector<std::string> col;
+    std::istringstream row(line);
+    for (std::string c; std::getline(row, c, ',');) col.push_back(c);
+    if (col.size() < 7) break;
+    const std::string map = col[2] == "1" ? col[6] : "(lost)";
+    if (map != last_map) flush(), first = col[0], last_map = map, run = 0;
+    ++run;
+  }
+  flush();
+  std::ifstream trajectory(node / "trajectory.tum");
+  for (int i = 0; std::getline(trajectory, line); ++i)
+    if (i % 20 == 0) {
+      std::istringstream row(line);
+      std::string t, x, y, z;
+      row >> t >> x >> y >> z;
+      o << "  " << t << " at " << x << " " << y << " " << z << "\n";
+    }
+  return o.str();
+}
+
 // The event lines (peers, hand-overs, ignored or cut-short maps) of every node log in `out`,
-// without the progress lines: what a failed run's cause is read from in CI, where the test's
-// folder is gone afterwards.
+// without the progress lines, then each node's digest: what a failed run's cause is read from
+// in CI, where the test's folder is gone afterwards.
 std::string nodeEvents(const fs::path& out) {
   std::string all;
   for (const auto& entry : fs::directory_iterator(out)) {
@@ -231,6 +276,8 @@ std::string nodeEvents(const fs::path& out) {
     for (std::string line; std::getline(in, line);)
       if (line.find("tracking ") == std::string::npos) all += line + "\n";
   }
+  for (const auto& entry : fs::directory_iterator(out))
+    if (entry.is_directory()) all += nodeDigest(entry.path());
   return all;
 }
 
@@ -371,12 +418,12 @@ class Namespaces {
 };
 
 // TR, LM and LC in namespaces 1, 2 and 3 on `domain`; the exit status of TR (LM and LC are waited
-// for, all three within 600 s). Logs are out/log1..3.
+// for, all three within 600 s). Logs are out/tr.log, lm.log and lc.log.
 int runInNamespaces(const Namespaces& ns, const fs::path& out, int domain, const std::string& tr_options = "") {
   const std::string bin = HIVESLAM_BINARY, dom = " --domain " + std::to_string(domain) + " ";
   auto node = [&](int i, const std::string& args) {
-    return "ip netns exec " + ns.name(i) + " " + bin + " node" + dom + args + " > " + (out / ("log" + std::to_string(i))).string() +
-           " 2>&1";
+    const std::string log = i == 1 ? "tr.log" : i == 2 ? "lm.log" : "lc.log";
+    return "ip netns exec " + ns.name(i) + " " + bin + " node" + dom + args + " > " + (out / log).string() + " 2>&1";
   };
   const std::string run = node(2, "--task lm --out " + (out / "lm").string()) + " & " +
                           node(3, "--task lc --out " + (out / "lc").string()) + " & " +
@@ -391,12 +438,13 @@ TEST(NodeProcesses, ThreeNodesInThreeNetworkNamespaces) {
   if (!ns.skipReason().empty()) GTEST_SKIP() << ns.skipReason();
   testing::TempDir out;
   const int status = runInNamespaces(ns, out.path(), 7);
-  ASSERT_EQ(status, 0) << std::ifstream(out / "log1").rdbuf();
+  ASSERT_EQ(status, 0) << nodeEvents(out.path());
   const auto tr = report(out / "tr" / "report.json"), lm = report(out / "lm" / "report.json");
   EXPECT_EQ(tasks(tr), std::vector<std::string>{"tr"});
   EXPECT_GT(tr.value("tracked_frames", 0), 200);
   EXPECT_EQ(lm.value("end_of_run", ""), "completed");
   EXPECT_EQ(tr.value("s_full_keyframes", 0), lm.value("s_full_keyframes", -1));
+  if (HasFailure()) std::cout << nodeEvents(out.path());
 }
 
 // One packet in 20 lost on every link, discovery and the end-of-run exchange included: the
@@ -410,7 +458,7 @@ TEST(NodeProcesses, ThreeNodesOverALossyLink) {
   testing::TempDir out;
   const int status = runInNamespaces(ns, out.path(), 8, kRealtime);
   EXPECT_GT(ns.dropped(), 100) << "the bridge dropped too few packets to test anything";
-  ASSERT_EQ(status, 0) << std::ifstream(out / "log1").rdbuf();
+  ASSERT_EQ(status, 0) << nodeEvents(out.path());
   const auto tr = report(out / "tr" / "report.json"), lm = report(out / "lm" / "report.json"),
              lc = report(out / "lc" / "report.json");
   EXPECT_EQ(tasks(tr), std::vector<std::string>{"tr"});
@@ -420,6 +468,7 @@ TEST(NodeProcesses, ThreeNodesOverALossyLink) {
     EXPECT_GT(tr.value("tracked_frames", 0), 200);
   }
   expectOneMap(tr, lm, lc);
+  if (HasFailure()) std::cout << nodeEvents(out.path());
 }
 
 }  // namespace
