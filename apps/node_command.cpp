@@ -73,6 +73,7 @@ void serve(const NodeCommandOptions& o, communication::Task task) {
   report["merges"] = ls.merges;
   report["global_bas"] = ls.global_bas;
   report["global_ba_sigma"] = ls.global_ba_sigma;  // 0 on a node that ran none
+  report["global_ba_scale_drift"] = ls.global_ba_scale_drift;  // 1 on a node that ran none
   report["loop_events"] = loopEventsJson(ls);
   size_t kfs = 0, points = 0;
   report["map_keyframes"] = nlohmann::json::array();

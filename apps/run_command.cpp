@@ -232,7 +232,8 @@ RunSummary runSlam(const RunOptions& o) {
                            {"rejected_geometry", ls.rejected_geometry},
                            {"global_bas_discarded", ls.global_bas_discarded},
                            {"global_ba_ms", ls.global_ba_ms},
-                           {"global_ba_sigma", ls.global_ba_sigma}};
+                           {"global_ba_sigma", ls.global_ba_sigma},
+                           {"global_ba_scale_drift", ls.global_ba_scale_drift}};
   if (const auto* topic = dynamic_cast<const TopicFrameSource*>(source.get()))
     dropped += static_cast<int>(topic->dropped());  // images the reader had to let go
   const bool realtime = mode == core::SlamSystem::Mode::Realtime;

@@ -127,6 +127,35 @@ TEST(MapCorrection, WhatIsMadeDuringAGlobalBaFollowsItsParentFromWhereItIsNow) {
   EXPECT_LT((kf4->T_cw * fresh->position - fresh_in_4).norm(), 1e-9) << "the new point relative to 4";
 }
 
+// A global BA that rescales the map (its free scale wandered), sent as rigid poses and moved
+// points. Keyframe 5 keeps only five points the BA moved (the rest culled or fused away), too
+// few to measure its own scale change: it takes the map's, and a frame posed on it lands where
+// the correction puts it. Left at no change, the frame kept its offset from the keyframe at the
+// old scale (a lossy-link run: a map eighty times smaller, frames a metre off).
+TEST(MapCorrection, AKeyframeWithTooFewMovedPointsTakesTheMapsScaleChange) {
+  Corridor c;
+  KeyFrame* kf5 = c.kfs[5].get();
+  Eigen::Isometry3d T_frame = kf5->T_cw;
+  T_frame.translation() += Eigen::Vector3d(-0.08, 0.02, 0.05);
+  const RelativePose frame = kf5->relative(T_frame);
+  const Sim3 S = {Eigen::Quaterniond(Eigen::AngleAxisd(0.1, Eigen::Vector3d::UnitY())), Eigen::Vector3d(0.1, 0, 0.2),
+                  1.0 / 80};
+  PoseCorrection correction;
+  for (const auto& kf : c.kfs) {
+    correction.before[kf.get()] = Sim3(kf->T_cw);
+    correction.after[kf.get()] = Sim3(moved(kf->T_cw, S));
+  }
+  int kept = 0;
+  for (const auto& p : kf5->points)
+    if (p && kept++ < 5) correction.points[p.get()] = S * p->position;
+  for (const auto& [id, p] : c.map.points)
+    if (!p->observations.count(kf5)) correction.points[p.get()] = S * p->position;
+  applyCorrection(c.map, correction, {1.0});
+
+  EXPECT_NEAR(kf5->scale(), S.s, 1e-9);
+  expectPose(moved(T_frame, S), kf5->poseOf(frame), "the frame posed on keyframe 5");
+}
+
 TEST(MapCorrection, ACulledKeyframeFollowsItsClosestNeighbourNotADistantParent) {
   Corridor c;
   // Keyframe 5's spanning tree parent is made the far origin; it shares the most points with 4.

@@ -12,6 +12,7 @@
 #include "core/optim/bundle_adjustment.hpp"
 #include "core/optim/map_ba_problem.hpp"
 #include "core/optim/pose_graph.hpp"
+#include "core/optim/scale_gauge.hpp"
 #include "core/optim/sim3_refine.hpp"
 
 namespace hiveslam::core {
@@ -466,7 +467,10 @@ void LoopCloser::globalBundleAdjustment(Map& map, int iterations, bool corrected
     o.outliers = settings_.global_ba_outliers_from_start && !corrected ? Outliers::FromStart : Outliers::SecondRound;
     stats_.global_ba_sigma = sigma;
   }
+  const std::vector<Eigen::Vector3d> centres = cameraCentres(ba);
   bundleAdjust(ba, o);
+  const double restored = restoreScale(ba, centres);  // only the origin is fixed: the scale was free (scale_gauge.hpp)
+  stats_.global_ba_scale_drift = std::max({stats_.global_ba_scale_drift, restored, 1.0 / restored});
   for (size_t i = 0; i < kfs.size(); ++i) correction.after[kfs[i]] = Sim3(ba.poses[i].q_cw, ba.poses[i].t_cw, 1.0);
   for (size_t i = 0; i < pts.size(); ++i) correction.points[pts[i]] = ba.points[i].p_w;
   {

@@ -43,6 +43,7 @@ struct LoopStats {
   int rejected_geometry = 0;  // consistent places that failed Sim3 verification
   double query_ms_total = 0, global_ba_ms_total = 0;
   double global_ba_sigma = 0;  // the noise the last global BA judged residuals by, in level sigmas
+  double global_ba_scale_drift = 1;  // the largest scale change a global BA made and had taken back (>= 1)
   std::vector<LoopEvent> events;
   std::vector<std::pair<int, double>> global_ba_ms;  // (keyframes, ms) per global BA
 };

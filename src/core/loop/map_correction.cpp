@@ -1,6 +1,7 @@
 #include "core/loop/map_correction.hpp"
 
 #include <algorithm>
+#include <optional>
 #include <unordered_set>
 #include <vector>
 
@@ -10,10 +11,17 @@ namespace hiveslam::core {
 
 namespace {
 
+double median(std::vector<double> v) {
+  auto mid = v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2);
+  std::nth_element(v.begin(), mid, v.end());
+  return *mid;
+}
+
 // Rigid poses and moved points (a global BA; a merge made at another node arrives so) still
 // rescale the map around a keyframe: how far its points are from it now, against before.
-double scaleChange(const KeyFrame& kf, const Sim3& before, const Sim3& after,
-                   const std::unordered_map<MapPoint*, Eigen::Vector3d>& moved) {
+// Nothing where too few of its points moved to tell.
+std::optional<double> scaleChange(const KeyFrame& kf, const Sim3& before, const Sim3& after,
+                                  const std::unordered_map<MapPoint*, Eigen::Vector3d>& moved) {
   std::vector<double> ratios;
   for (const auto& p : kf.points) {
     if (!p || p->bad) continue;
@@ -22,10 +30,8 @@ double scaleChange(const KeyFrame& kf, const Sim3& before, const Sim3& after,
     const double was = (before * p->position).norm(), is = (after * it->second).norm();
     if (was > 1e-9 && is > 1e-9) ratios.push_back(is / was);
   }
-  if (ratios.size() < 8) return 1.0;
-  auto mid = ratios.begin() + static_cast<std::ptrdiff_t>(ratios.size() / 2);
-  std::nth_element(ratios.begin(), mid, ratios.end());
-  return *mid;
+  if (ratios.size() < 8) return std::nullopt;
+  return median(std::move(ratios));
 }
 
 }  // namespace
@@ -33,17 +39,32 @@ double scaleChange(const KeyFrame& kf, const Sim3& before, const Sim3& after,
 void applyCorrection(Map& map, const PoseCorrection& c, const std::vector<double>& scales) {
   // Correction of every keyframe, live or retired: old world -> new world.
   std::unordered_map<KeyFrame*, Sim3> moves;
+  std::unordered_map<KeyFrame*, Sim3> before_of;
+  std::unordered_map<KeyFrame*, double> scale_of;
   for (const auto& [kf, after] : c.after) {
     // The optimization started from `before`, but it ran without the lock: local mapping may
     // have moved the keyframe since, and posed new keyframes and points on it where it is now.
     // What it carries moves from where it is now (with the optimization's scale), or each
     // local BA that landed during a global BA would be baked into its children as an error.
     const Sim3& started = c.before.at(kf);
-    const Sim3 before = kf->bad ? started
-                                : Sim3(Eigen::Quaterniond(kf->T_cw.linear()), started.s * kf->T_cw.translation(),
-                                       started.s);
-    moves[kf] = after.inverse() * Sim3(Eigen::Quaterniond::Identity(), Eigen::Vector3d::Zero(),
-                                       c.points.empty() ? 1.0 : scaleChange(*kf, before, after, c.points)) * before;
+    before_of[kf] = kf->bad ? started
+                            : Sim3(Eigen::Quaterniond(kf->T_cw.linear()), started.s * kf->T_cw.translation(), started.s);
+    if (c.points.empty()) continue;
+    if (const auto s = scaleChange(*kf, before_of[kf], after, c.points)) scale_of[kf] = *s;
+  }
+  // A keyframe with too few moved points to measure (culled down to a handful, or mostly fused
+  // away at a merge seam) takes the map's median change, not none: left at 1 while its pose
+  // moved to a map rescaled eighty-fold, it kept the frames posed on it at the old scale.
+  double typical = 1.0;
+  if (!scale_of.empty()) {
+    std::vector<double> all;
+    for (const auto& [kf, s] : scale_of) all.push_back(s);
+    typical = median(std::move(all));
+  }
+  for (const auto& [kf, after] : c.after) {
+    const auto it = scale_of.find(kf);
+    const double s = c.points.empty() ? 1.0 : it != scale_of.end() ? it->second : typical;
+    moves[kf] = after.inverse() * Sim3(Eigen::Quaterniond::Identity(), Eigen::Vector3d::Zero(), s) * before_of.at(kf);
   }
   auto next = [](KeyFrame* k) -> KeyFrame* {
     if (k->bad && k->anchor) return k->anchor;
