@@ -22,7 +22,9 @@ double restoreScale(BaProblem& problem, const std::vector<Eigen::Vector3d>& cent
     spread_before += (centres_before[i] - centres_before[anchor]).norm();
     spread_after += (after[i] - o).norm();
   }
-  if (spread_before <= 0 || spread_after <= 0) return 1.0;
+  // Cameras that (nearly) share the fixed one's centre give no scale to restore.
+  constexpr double kNoSpread = 1e-12;
+  if (spread_before <= kNoSpread || spread_after <= kNoSpread) return 1.0;
   const double s = spread_before / spread_after;
   // x -> o + s (x - o): a camera keeps its rotation; its centre moves, so t = -R c follows.
   for (size_t i = 0; i < problem.poses.size(); ++i) {
