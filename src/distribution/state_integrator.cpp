@@ -507,8 +507,8 @@ bool StateIntegrator::applyGlobal(const std::vector<MapRecord>& batches, bool au
     //   each node's keyframes reach the sender in order, one by one through its mapping queue.
     // - A point, if the snapshot holds a newer object of its node (points and keyframes share
     //   each node's id counter, and points come with or after the keyframe that made them).
-    //   Judged by this rule, a keyframe was erased when the snapshot held only the points its
-    //   predecessor brought, newer than it (a new map's second keyframe).
+    //   Keyframes judged that way too lost a new map's second keyframe: the snapshot held the
+    //   first and the points it brought, numbered after the second.
     std::vector<Id> ids = kf_ids;
     ids.insert(ids.end(), point_ids.begin(), point_ids.end());
     const auto newest = newestByNode(ids), newest_keyframe = newestByNode(kf_ids);

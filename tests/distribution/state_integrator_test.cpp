@@ -78,6 +78,26 @@ class EpochLabels : public ::testing::Test {
     }
   }
 
+  // Keyframe `kf`'s record at T_cw, without links.
+  static KeyFrameRecord keyframeRecord(Id kf, const Eigen::Isometry3d& T_cw) {
+    KeyFrameRecord k;
+    k.id = kf;
+    k.map = kMap;
+    k.links = false;
+    k.T_cw = T_cw;
+    return k;
+  }
+
+  // The map's first `count` points, moved by S.
+  static void addPoints(MapRecord& m, int count, const core::Sim3& S = core::Sim3()) {
+    for (int i = 0; i < count; ++i) {
+      PointRecord p;
+      p.id = 100 + i;
+      p.position = S * pointAt(i);
+      m.points.push_back(p);
+    }
+  }
+
   // The loop closure: the whole map moves by S from where it was made (the global map of
   // `epoch`).
   void correct(const core::Sim3& S, uint64_t epoch = 1) {
@@ -85,20 +105,8 @@ class EpochLabels : public ::testing::Test {
     g.kind = MapRecord::Kind::Global;
     g.map = kMap;
     g.epoch = epoch;
-    for (Id kf : {kFirst, kSecond}) {
-      KeyFrameRecord k;
-      k.id = kf;
-      k.map = kMap;
-      k.links = false;
-      k.T_cw = moved(poseAt(kf == kFirst ? 0.0 : 0.4), S);
-      g.keyframes.push_back(k);
-    }
-    for (int i = 0; i < kPoints; ++i) {
-      PointRecord p;
-      p.id = 100 + i;
-      p.position = S * pointAt(i);
-      g.points.push_back(p);
-    }
+    for (Id kf : {kFirst, kSecond}) g.keyframes.push_back(keyframeRecord(kf, moved(poseAt(kf == kFirst ? 0.0 : 0.4), S)));
+    addPoints(g, kPoints, S);
     integrator_.applyGlobal({g}, false);
   }
 
@@ -109,20 +117,9 @@ class EpochLabels : public ::testing::Test {
     g.kind = MapRecord::Kind::Global;
     g.map = kMap;
     g.epoch = 1;
-    for (Id kf : {kFirst, kSecond, newer}) {
-      KeyFrameRecord k;
-      k.id = kf;
-      k.map = kMap;
-      k.links = false;
-      k.T_cw = poseAt(kf == kFirst ? 0.0 : kf == kSecond ? 0.4 : 0.8);
-      g.keyframes.push_back(k);
-    }
-    for (int i = 0; i < kPoints - 1; ++i) {
-      PointRecord p;
-      p.id = 100 + i;
-      p.position = pointAt(i);
-      g.points.push_back(p);
-    }
+    for (Id kf : {kFirst, kSecond, newer})
+      g.keyframes.push_back(keyframeRecord(kf, poseAt(kf == kFirst ? 0.0 : kf == kSecond ? 0.4 : 0.8)));
+    addPoints(g, kPoints - 1);
     return g;
   }
 
@@ -132,20 +129,8 @@ class EpochLabels : public ::testing::Test {
     m.map = kMap;
     m.epoch = 0;
     if (with_keyframes)
-      for (Id kf : {kFirst, kSecond}) {
-        KeyFrameRecord k;
-        k.id = kf;
-        k.map = kMap;
-        k.links = false;
-        k.T_cw = poseAt(kf == kFirst ? 0.0 : 0.4);
-        m.keyframes.push_back(k);
-      }
-    for (int i = 0; i < kPoints; ++i) {
-      PointRecord p;
-      p.id = 100 + i;
-      p.position = pointAt(i);
-      m.points.push_back(p);
-    }
+      for (Id kf : {kFirst, kSecond}) m.keyframes.push_back(keyframeRecord(kf, poseAt(kf == kFirst ? 0.0 : 0.4)));
+    addPoints(m, kPoints);
     PointRecord p;
     p.id = kNewPoint;
     p.position = new_point;
@@ -502,18 +487,8 @@ TEST_F(EpochLabels, AnAuthoritativeSnapshotTakenBeforeTheSenderMappedAKeyframeLe
   g.kind = MapRecord::Kind::Global;
   g.map = kMap;
   g.epoch = 1;
-  KeyFrameRecord k;
-  k.id = kFirst;
-  k.map = kMap;
-  k.links = false;
-  k.T_cw = poseAt(0.0);
-  g.keyframes.push_back(k);
-  for (int i = 0; i < kPoints; ++i) {
-    PointRecord p;
-    p.id = 100 + i;
-    p.position = pointAt(i);
-    g.points.push_back(p);
-  }
+  g.keyframes.push_back(keyframeRecord(kFirst, poseAt(0.0)));
+  addPoints(g, kPoints);
   ASSERT_TRUE(integrator_.applyGlobal({g}, true));
   EXPECT_EQ(observer_.digest().keyframes.count(kSecond), 1u) << "left S_full";
   auto map = slam_.findMap(kMap);

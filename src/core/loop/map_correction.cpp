@@ -63,7 +63,7 @@ void applyCorrection(Map& map, const PoseCorrection& c, const std::vector<double
   }
   for (const auto& [kf, after] : c.after) {
     const auto it = scale_of.find(kf);
-    const double s = c.points.empty() ? 1.0 : it != scale_of.end() ? it->second : typical;
+    const double s = it != scale_of.end() ? it->second : typical;  // 1 for poses alone (scale in them)
     moves[kf] = after.inverse() * Sim3(Eigen::Quaterniond::Identity(), Eigen::Vector3d::Zero(), s) * before_of.at(kf);
   }
   auto next = [](KeyFrame* k) -> KeyFrame* {
