@@ -111,7 +111,7 @@ void addNodeCommand(CLI::App& app) {
   cmd->add_option("--domain", o->domain, "DDS domain id (the ROS_DOMAIN_ID)")->capture_default_str();
   cmd->add_option("--name", o->name, "Node name (default: the task)");
   cmd->add_option("--id", o->id, "Node id, 1-65535: the high bits of the ids it makes (default: 1 tr, 2 lm, 3 lc)");
-  cmd->add_option("--expect", o->expect, "TR: comma-separated tasks to wait for before the first frame (lm,lc)");
+  cmd->add_option("--expect", o->expect, "TR: comma-separated tasks to wait for before the first frame (lm,lc), until they have heard this node too");
   cmd->add_option("--wait", o->wait_seconds, "TR: seconds to wait for --expect")->capture_default_str();
   cmd->add_option("--config", o->config, "Settings YAML");
   cmd->add_option("--times", o->times, "TR: times file for image folders and videos");

@@ -122,10 +122,13 @@ RunSummary runSlam(const RunOptions& o) {
       want |= communication::taskBit(task);
     }
     const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(o.network.wait_seconds);
-    while ((node->presentTasks() & want) != want && std::chrono::steady_clock::now() < deadline)
+    while ((node->mutualTasks() & want) != want && std::chrono::steady_clock::now() < deadline)
       std::this_thread::sleep_for(std::chrono::milliseconds(20));
     if ((node->presentTasks() & want) != want)
       throw InputError(fmt::format("the expected peers ({}) did not appear within {} s on DDS domain {}",
+                                   fmt::join(o.network.expect, ","), o.network.wait_seconds, o.network.domain));
+    if ((node->mutualTasks() & want) != want)
+      throw InputError(fmt::format("the expected peers ({}) appeared but did not hear this node within {} s on DDS domain {}",
                                    fmt::join(o.network.expect, ","), o.network.wait_seconds, o.network.domain));
   }
   if (!o.atlas_in.empty()) {
@@ -212,6 +215,7 @@ RunSummary runSlam(const RunOptions& o) {
   report["frames_refined"] = frames_refined;
   report["failures"] = slam.failures();
   report["keyframes_deferred"] = slam.keyframesDeferred();
+  report["keyframes_made_busy"] = slam.keyframesMadeBusy();
   report["keyframes"] = keyframe_count;
   report["maps"] = maps.size();
   report["map_keyframes"] = nlohmann::json::array();

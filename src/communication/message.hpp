@@ -49,6 +49,10 @@ struct PeerInfo {
   uint16_t cores = 1;
   float load = 0;
   bool leaving = false;
+  // The peers this node has heard, in id order: a node that sees a peer cannot know whether
+  // that peer sees it too (discovery is one-sided; over a lossy link the two directions came
+  // seconds apart), and starting to track before it does sent keyframes nobody read.
+  std::vector<uint16_t> seen;
 };
 
 }  // namespace hiveslam::communication

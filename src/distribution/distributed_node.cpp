@@ -101,6 +101,10 @@ DistributedNode::~DistributedNode() {
 
 PeerInfo DistributedNode::self() const {
   PeerInfo p;
+  {
+    std::lock_guard lock(mutex_);
+    for (const auto& [id, peer] : peers_) p.seen.push_back(id);
+  }
   p.node = options_.id;
   p.name = options_.name;
   p.task = options_.task;
@@ -128,6 +132,24 @@ uint8_t DistributedNode::presentTasks() const {
   uint8_t present = 0;
   for (const auto& [id, peer] : peers_) present |= taskBit(peer.task);
   return present;
+}
+
+uint8_t DistributedNode::mutualTasks() const {
+  std::vector<PeerInfo> mutual;
+  {
+    std::lock_guard lock(mutex_);
+    for (const auto& [id, peer] : peers_)
+      if (std::find(peer.seen.begin(), peer.seen.end(), options_.id) != peer.seen.end()) mutual.push_back(peer);
+  }
+  uint8_t tasks = 0;
+  for (const auto& peer : mutual) {
+    // A mapping node must read tracking's keyframes from the first: the first map goes out once.
+    if (options_.task == Task::Tracking && peer.task == Task::Mapping &&
+        !transport_.peerReads(Topic::TrKeyframes, peer.node))
+      continue;
+    tasks |= taskBit(peer.task);
+  }
+  return tasks;
 }
 
 Plan DistributedNode::plan() const {
@@ -163,6 +185,8 @@ void DistributedNode::onPeer(const PeerInfo& peer, bool present) {
       spdlog::info("node {}: {} batches of an unfinished global map from {} dropped", options_.id, dropped, peer.name);
   if (leaving) return;  // no task is taken over or handed on while the transport goes down
   applyPlan();
+  // The peers it sees changed: they learn it from the next announcement (see mutualTasks()).
+  if (newcomer || !present) transport_.announce(self());
   // A node that joins late gets the maps so far from the gateway; a mapping node that joins
   // (or returns) gets them from the node that mapped until now, which gives mapping up to it.
   const Plan after = plan();

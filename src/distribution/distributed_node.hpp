@@ -61,6 +61,10 @@ class DistributedNode final : public core::SystemEvents {
   Plan plan() const;
   // taskBit()s of the peers present now.
   uint8_t presentTasks() const;
+  // taskBit()s of the present peers that have heard this node too (PeerInfo::seen) and, for
+  // a mapping peer of a tracking node, read its keyframes: what a tracking node waits for
+  // before its first frame, since what it sends a peer that has not heard it yet is lost.
+  uint8_t mutualTasks() const;
   const Observer& observer() const { return observer_; }
   // What the node adds to `hiveslam run`'s report: tasks, traffic, message rates.
   nlohmann::json report(double seconds) const;

@@ -60,6 +60,7 @@ void applySlamSettings(const std::filesystem::path& file, core::SlamSettings& s)
       {"keyframe_min_frames", set(s.keyframe_min_frames)},
       {"keyframe_max_frames", set(s.keyframe_max_frames)},
       {"keyframe_ratio", set(s.keyframe_ratio)},
+      {"keyframe_weak_ratio", set(s.keyframe_weak_ratio)},
       {"keyframe_min_inliers", set(s.keyframe_min_inliers)},
       {"lost_frames_before_new_map", set(s.lost_frames_before_new_map)},
       {"triangulation_neighbours", set(s.triangulation_neighbours)},

@@ -19,6 +19,7 @@
 
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
 #include <array>
 #include <atomic>
 #include <chrono>
@@ -47,7 +48,7 @@ constexpr const char* kNodeTopic = "rt/hiveslam/nodes";
 
 hiveslam_msgs::msg::NodeInfo toIdl(const PeerInfo& p) {
   hiveslam_msgs::msg::NodeInfo m;
-  m.version(1);
+  m.version(2);
   m.node(p.node);
   m.name(p.name);
   m.task(static_cast<uint8_t>(p.task));
@@ -56,6 +57,8 @@ hiveslam_msgs::msg::NodeInfo toIdl(const PeerInfo& p) {
   m.cores(p.cores);
   m.load(p.load);
   m.leaving(p.leaving);
+  // Bounded in the IDL; a network of more nodes than that announces the first of them.
+  m.seen(std::vector<uint16_t>(p.seen.begin(), p.seen.begin() + static_cast<long>(std::min<size_t>(p.seen.size(), 256))));
   return m;
 }
 
@@ -69,6 +72,7 @@ PeerInfo fromIdl(const hiveslam_msgs::msg::NodeInfo& m) {
   p.cores = m.cores();
   p.load = m.load();
   p.leaving = m.leaving();
+  p.seen = m.seen();
   return p;
 }
 
@@ -184,7 +188,7 @@ struct DdsTransport::Impl : public dds::DomainParticipantListener {
       } else {
         auto it = peers.find(p.node);
         const bool same = it != peers.end() && it->second.second.incarnation == p.incarnation &&
-                          it->second.second.hosted == p.hosted;
+                          it->second.second.hosted == p.hosted && it->second.second.seen == p.seen;
         peers[p.node] = {prefix, p};
         if (same) return;  // a heartbeat: nothing new
       }

@@ -96,6 +96,7 @@ class SlamSystem {
   std::vector<std::shared_ptr<Map>> maps() const;
   int failures() const { return tracker_.failures(); }
   int keyframesDeferred() const { return tracker_.keyframesDeferred(); }
+  int keyframesMadeBusy() const { return tracker_.keyframesMadeBusy(); }
   const MappingStats& mappingStats() const { return mapper_.stats(); }
   const LoopStats& loopStats() const { return closer_.stats(); }
   // The map a frame's poses live in now (a merged map's frames live in the map it joined).

@@ -1,6 +1,7 @@
 #include "core/tracking/tracker.hpp"
 
 #include <algorithm>
+#include <limits>
 #include <opencv2/calib3d.hpp>
 #include <set>
 #include <unordered_set>
@@ -96,6 +97,7 @@ TrackingOutput Tracker::track(Frame frame, bool mapping_idle) {
   if (decision == KeyframeDecision::Make) {
     out.new_keyframe = makeKeyframe(current);
     ++keyframes_made_;
+    if (!mapping_idle) ++keyframes_made_busy_;
     reference_ = out.new_keyframe;
     last_keyframe_frame_ = current.frame.index;
   } else if (decision == KeyframeDecision::Deferred) {
@@ -442,10 +444,15 @@ bool Tracker::relocalize(Tracked& c) {
   return false;
 }
 
+double Tracker::trackedShare() const {
+  const int reference_points = reference_ ? reference_->trackedPoints(keyframes_made_ <= 2 ? 2 : 3) : 0;
+  // Without reference points no keyframe is due: as if every one were tracked.
+  return reference_points > 0 ? static_cast<double>(inliers_) / reference_points : std::numeric_limits<double>::infinity();
+}
+
 bool Tracker::keyframeWanted(const Tracked& c) const {
   if (c.frame.index - last_keyframe_frame_ < static_cast<size_t>(settings_.keyframe_min_frames)) return false;
-  const int reference_points = reference_ ? reference_->trackedPoints(keyframes_made_ <= 2 ? 2 : 3) : 0;
-  return inliers_ < settings_.keyframe_ratio * reference_points && inliers_ > settings_.keyframe_min_inliers;
+  return trackedShare() < settings_.keyframe_ratio && inliers_ > settings_.keyframe_min_inliers;
 }
 
 Tracker::KeyframeDecision Tracker::keyframeDecision(const Tracked& c, bool mapping_idle) const {
@@ -454,7 +461,8 @@ Tracker::KeyframeDecision Tracker::keyframeDecision(const Tracked& c, bool mappi
     return KeyframeDecision::None;
   if (!keyframeWanted(c)) return KeyframeDecision::None;  // also: too soon after the last one
   const size_t since = c.frame.index - last_keyframe_frame_;
-  const bool timely = since >= static_cast<size_t>(settings_.keyframe_max_frames) || mapping_idle;
+  const bool timely = since >= static_cast<size_t>(settings_.keyframe_max_frames) || mapping_idle ||
+                      trackedShare() < settings_.keyframe_weak_ratio;
   return timely ? KeyframeDecision::Make : KeyframeDecision::Deferred;
 }
 

@@ -60,6 +60,8 @@ class Tracker {
   // Frames at which a keyframe was due but mapping was busy (real-time runs): how often the
   // keyframe decision waited on mapping, local or remote.
   int keyframesDeferred() const { return keyframes_deferred_; }
+  // Made while mapping was busy: a keyframe overdue by keyframe_max_frames or tracking weak.
+  int keyframesMadeBusy() const { return keyframes_made_busy_; }
   const std::shared_ptr<Map>& map() const { return map_; }
 
  private:
@@ -83,6 +85,8 @@ class Tracker {
   enum class KeyframeDecision { None, Make, Deferred };
   KeyframeDecision keyframeDecision(const Tracked& current, bool mapping_idle) const;
   bool keyframeWanted(const Tracked& current) const;  // the point-ratio half of the decision
+  // This frame's inliers over the points the reference keyframe tracks (infinite without one).
+  double trackedShare() const;
   std::shared_ptr<KeyFrame> makeKeyframe(const Tracked& current);
   // The keyframe a tracked frame's pose is kept relative to (TrackingOutput::reference).
   std::shared_ptr<KeyFrame> nearestKeyframe(const Tracked& current) const;
@@ -111,6 +115,7 @@ class Tracker {
   // behind a busy local mapping thread.
   int keyframes_made_ = 0;
   int keyframes_deferred_ = 0;
+  int keyframes_made_busy_ = 0;
   std::function<void()> wait_for_mapping_;
   const place::Vocabulary* vocabulary_ = nullptr;
   const KeyframeDatabase* database_ = nullptr;
