@@ -171,9 +171,11 @@ RunSummary runSlam(const RunOptions& o) {
   }
   nlohmann::json node_report;
   if (node) {
-    if (!node->finishRun(std::chrono::seconds(120)))
+    const bool completed = node->finishRun(std::chrono::seconds(120));
+    if (!completed)
       fmt::print(stderr, "warning: the end-of-run exchange did not complete; the maps may differ between nodes\n");
     node_report = node->report(monitor.wallSeconds());
+    node_report["end_of_run"] = completed ? "completed" : "incomplete";
   } else {
     slam.drain();  // the end of the run: the last keyframes mapped, the final global BA
   }

@@ -179,10 +179,30 @@ void DistributedNode::onPeer(const PeerInfo& peer, bool present) {
   spdlog::info("node {}: peer {} ({}) {}", options_.id, peer.name, communication::taskName(peer.task),
                present ? (newcomer ? "joined" : "changed") : "left");
   // A global map it was sending when it died would otherwise wait here, half collected, until
-  // its next batch: it is never completed.
-  if (!present || restarted)
-    if (const size_t dropped = observer_.dropPendingGlobals(peer.node))
-      spdlog::info("node {}: {} batches of an unfinished global map from {} dropped", options_.id, dropped, peer.name);
+  // its next batch: it is never completed. A node that left is judged once the packets it
+  // sent before leaving are handled: dropped at the notice, the batches still queued here of
+  // its last snapshot started a collection never completed (LC ended 71 points short, session
+  // 39). A restarted node's old packets are all in; its new ones must not be dropped.
+  const auto drop = [this, node = peer.node, name = peer.name] {
+    if (const size_t dropped = observer_.dropPendingGlobals(node))
+      spdlog::info("node {}: {} batches of an unfinished global map from {} dropped", options_.id, dropped, name);
+  };
+  if (restarted) {
+    drop();
+  } else if (!present) {
+    {
+      std::lock_guard lock(mutex_);
+      ++departures_;
+    }
+    handler_->afterIncoming([this, drop] {
+      drop();
+      {
+        std::lock_guard lock(mutex_);
+        ++departures_handled_;
+      }
+      changed_.notify_all();
+    });
+  }
   if (leaving) return;  // no task is taken over or handed on while the transport goes down
   applyPlan();
   // The peers it sees changed: they learn it from the next announcement (see mutualTasks()).
@@ -520,6 +540,18 @@ bool DistributedNode::finishRun(std::chrono::milliseconds timeout) {
   }
   if (p.keyframes_to_lm) {
     publisher_->push({nullptr, nullptr, Topic::TrKeyframes, static_cast<uint8_t>(Control::EndOfSequence)});
+    // The Done comes from the gateway: one that leaves first sends none, and this node then
+    // maps what it had sent it and ends without (it waited out the whole timeout before). The
+    // leaving notice may come before the Done is handled here, behind the last snapshot.
+    bool done = false;
+    {
+      std::unique_lock lock(mutex_);
+      done = changed_.wait_for(lock, timeout, [&] {
+        return done_ || (!plan_.keyframes_to_lm && departures_handled_ == departures_);
+      }) && done_;
+    }
+    if (!done && plan().mapping) slam_.drain();
+    return done;
   } else if (p.local_maps) {
     finishAsGateway();  // this node maps: it is the gateway
   } else {

@@ -133,6 +133,7 @@ class DistributedNode final : public core::SystemEvents {
   int maps_awaited_ = 0;  // keyframes that waited for a hand-over
   int maps_asked_for_ = 0;  // of those, the ones whose map was asked for (Control::SendMap)
   int keyframes_taken_back_ = 0;  // unacknowledged keyframes mapped here after the LM left
+  int departures_ = 0, departures_handled_ = 0;  // peers that left; of those, handled in order
   uint64_t knownEpoch(core::Id map) const;  // the newer of synced_ and published_; mutex_ held
   void releaseHeld(core::Id map);           // applies the held local maps the epoch has reached
   std::thread finisher_;  // the end-of-run exchange (LM, LC)

@@ -93,7 +93,15 @@ bool MapHandler::idle() const {
 void MapHandler::incoming(communication::Message&& m, Topic topic) {
   {
     std::lock_guard lock(mutex_);
-    inbox_.emplace_back(std::move(m), topic);
+    inbox_.push_back({std::move(m), topic, {}});
+  }
+  wake_.notify_all();
+}
+
+void MapHandler::afterIncoming(std::function<void()> f) {
+  {
+    std::lock_guard lock(mutex_);
+    inbox_.push_back({{}, {}, std::move(f)});
   }
   wake_.notify_all();
 }
@@ -178,11 +186,14 @@ void MapHandler::loop() {
     const bool local_pending =
         std::any_of(outgoing_.begin(), outgoing_.end(), [](const auto& o) { return !o.second.dirty.empty() || !o.second.dirty_points.empty(); });
     if (!inbox_.empty()) {
-      auto [m, topic] = std::move(inbox_.front());
+      Inbound in = std::move(inbox_.front());
       inbox_.pop_front();
       busy_ = true;
       lock.unlock();
-      handleIncoming(m, topic);
+      if (in.after)
+        in.after();
+      else
+        handleIncoming(in.message, in.topic);
       lock.lock();
       continue;
     }

@@ -51,6 +51,10 @@ class MapHandler {
   ~MapHandler();
 
   void incoming(communication::Message&& m, communication::Topic topic);
+  // Runs `f` on the handler thread once everything that came in before has been handled. A
+  // peer's leaving notice comes on its own path and can overtake what the peer sent just before
+  // leaving (its last snapshot, its Done): what the node does about the leaving waits for those.
+  void afterIncoming(std::function<void()> f);
   // Local mapping changed `kf` and up to `window` of its covisible keyframes (the setting's
   // local_window when negative), sent on `topic` with the points they see. `acknowledge`: the
   // batch that carries `kf` also tells its maker that `kf` is mapped (MapRecord::mapped).
@@ -116,7 +120,12 @@ class MapHandler {
 
   mutable std::mutex mutex_;  // guards the queues below
   std::condition_variable wake_;
-  std::deque<std::pair<communication::Message, communication::Topic>> inbox_;
+  struct Inbound {
+    communication::Message message;
+    communication::Topic topic{};
+    std::function<void()> after;  // set: a marker (afterIncoming), no message
+  };
+  std::deque<Inbound> inbox_;
   std::unordered_map<core::Id, Outgoing> outgoing_;  // by map
   std::deque<GlobalJob> globals_;
   bool stopping_ = false, busy_ = false;

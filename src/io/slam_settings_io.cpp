@@ -133,13 +133,14 @@ void applyDdsSettings(const std::filesystem::path& file, communication::DdsOptio
       {"max_datagram_bytes", set(o.max_datagram_bytes)},
       {"heartbeat_ms", set(o.heartbeat_ms)},
       {"history_depth", set(o.history_depth)},
+      {"leave_flush_ms", set(o.leave_flush_ms)},
   };
   apply(file, section, keys, "dds.");
   // 576 bytes: the datagram every IPv4 host must take whole; 65500: UDP's limit.
   if (o.max_datagram_bytes < 576 || o.max_datagram_bytes > 65500 || o.heartbeat_ms < 1 || o.heartbeat_ms > 60000 ||
-      o.history_depth < 1)
+      o.history_depth < 1 || o.leave_flush_ms < 0)
     throw InputError(file.string() + ": dds settings out of range (max_datagram_bytes 576-65500, heartbeat_ms 1-60000, "
-                     "history_depth >= 1)");
+                     "history_depth >= 1, leave_flush_ms >= 0)");
 }
 
 }  // namespace hiveslam::io

@@ -14,6 +14,11 @@ struct DdsOptions {
   // How often a reliable writer with unacknowledged packets says what it has sent, so that a
   // reader notices a lost last fragment (Fast DDS's default is 3 s).
   int heartbeat_ms = 100;
+  // A leaving node waits up to this long for its peers to acknowledge what it has written (the
+  // end-of-run Done and the last snapshot before it). A dead peer is no longer waited for once
+  // its lease ends (2 s); a live one on a slow link is: over a 5 Mbit/s link the last snapshot
+  // took longer than the 1 s once waited, and TR then waited 120 s for a Done that never came.
+  int leave_flush_ms = 20000;
 };
 
 }  // namespace hiveslam::communication

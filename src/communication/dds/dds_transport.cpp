@@ -430,8 +430,12 @@ void DdsTransport::stop() {
     // What is queued goes out before the leaving notice: a peer that hears of the leaving
     // drops its subscriptions to this node's topics, and with them the last packets (the
     // end-of-run Done was lost that way in 4 of 20 bench runs).
-    for (auto* w : d.writers)
-      if (w) w->wait_for_acknowledgments(Duration_t(1, 0));
+    const auto until = std::chrono::steady_clock::now() + std::chrono::milliseconds(d.options.leave_flush_ms);
+    for (auto* w : d.writers) {
+      const auto left = std::chrono::duration_cast<std::chrono::nanoseconds>(until - std::chrono::steady_clock::now()).count();
+      if (w && left > 0)
+        w->wait_for_acknowledgments(Duration_t(static_cast<int32_t>(left / 1'000'000'000), static_cast<uint32_t>(left % 1'000'000'000)));
+    }
   }
   d.write(last);  // peers learn at once, not after the lease
   if (d.node_writer) d.node_writer->wait_for_acknowledgments(Duration_t(0, 200'000'000));
