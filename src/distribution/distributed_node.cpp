@@ -100,11 +100,9 @@ DistributedNode::~DistributedNode() {
 }
 
 PeerInfo DistributedNode::self() const {
+  std::lock_guard lock(mutex_);
   PeerInfo p;
-  {
-    std::lock_guard lock(mutex_);
-    for (const auto& [id, peer] : peers_) p.seen.push_back(id);
-  }
+  for (const auto& [id, peer] : peers_) p.seen.push_back(id);
   p.node = options_.id;
   p.name = options_.name;
   p.task = options_.task;
