@@ -432,9 +432,8 @@ void DdsTransport::stop() {
     // end-of-run Done was lost that way in 4 of 20 bench runs).
     const auto until = std::chrono::steady_clock::now() + std::chrono::milliseconds(d.options.leave_flush_ms);
     for (auto* w : d.writers) {
-      const auto left = std::chrono::duration_cast<std::chrono::nanoseconds>(until - std::chrono::steady_clock::now()).count();
-      if (w && left > 0)
-        w->wait_for_acknowledgments(Duration_t(static_cast<int32_t>(left / 1'000'000'000), static_cast<uint32_t>(left % 1'000'000'000)));
+      const double left = std::chrono::duration<double>(until - std::chrono::steady_clock::now()).count();
+      if (w && left > 0) w->wait_for_acknowledgments(Duration_t(left));
     }
   }
   d.write(last);  // peers learn at once, not after the lease

@@ -83,7 +83,7 @@ TrackingOutput Tracker::track(Frame frame, bool mapping_idle) {
   out.tracked = true;
   out.T_cw = current.T_cw;
   out.inliers = inliers_;
-  if (!mapping_idle && wait_for_mapping_ && keyframeWanted(current)) {
+  if (!mapping_idle && wait_for_mapping_ && keyframeWanted(current, trackedShare())) {
     lock.unlock();
     wait_for_mapping_();
     lock.lock();
@@ -450,19 +450,20 @@ double Tracker::trackedShare() const {
   return reference_points > 0 ? static_cast<double>(inliers_) / reference_points : std::numeric_limits<double>::infinity();
 }
 
-bool Tracker::keyframeWanted(const Tracked& c) const {
+bool Tracker::keyframeWanted(const Tracked& c, double share) const {
   if (c.frame.index - last_keyframe_frame_ < static_cast<size_t>(settings_.keyframe_min_frames)) return false;
-  return trackedShare() < settings_.keyframe_ratio && inliers_ > settings_.keyframe_min_inliers;
+  return share < settings_.keyframe_ratio && inliers_ > settings_.keyframe_min_inliers;
 }
 
 Tracker::KeyframeDecision Tracker::keyframeDecision(const Tracked& c, bool mapping_idle) const {
   if (relocalizedWithin(c.frame, static_cast<size_t>(settings_.keyframe_max_frames)) &&
       keyframes_made_ > settings_.keyframe_max_frames)
     return KeyframeDecision::None;
-  if (!keyframeWanted(c)) return KeyframeDecision::None;  // also: too soon after the last one
+  const double share = trackedShare();  // counts the reference's points: once per frame
+  if (!keyframeWanted(c, share)) return KeyframeDecision::None;  // also: too soon after the last one
   const size_t since = c.frame.index - last_keyframe_frame_;
   const bool timely = since >= static_cast<size_t>(settings_.keyframe_max_frames) || mapping_idle ||
-                      trackedShare() < settings_.keyframe_weak_ratio;
+                      share < settings_.keyframe_weak_ratio;
   return timely ? KeyframeDecision::Make : KeyframeDecision::Deferred;
 }
 

@@ -84,7 +84,8 @@ class Tracker {
   // Made, or due but held back because mapping is busy (counted as deferred), or neither.
   enum class KeyframeDecision { None, Make, Deferred };
   KeyframeDecision keyframeDecision(const Tracked& current, bool mapping_idle) const;
-  bool keyframeWanted(const Tracked& current) const;  // the point-ratio half of the decision
+  // The point-ratio half of the decision, given trackedShare().
+  bool keyframeWanted(const Tracked& current, double share) const;
   // This frame's inliers over the points the reference keyframe tracks (infinite without one).
   double trackedShare() const;
   std::shared_ptr<KeyFrame> makeKeyframe(const Tracked& current);
