@@ -1,6 +1,7 @@
 // hiveslam node --task tr|lm|lc: one node of the distributed system on a DDS domain. TR reads a
 // dataset (what `hiveslam run` reads) and writes what `run` writes; LM and LC serve until the
-// end-of-run exchange completes (or SIGINT/SIGTERM), then write DIR/report.json.
+// end-of-run exchange completes (or SIGINT/SIGTERM, or an LC's gateway left it alone after it
+// answered), then write DIR/report.json.
 #include <fmt/format.h>
 
 #include <atomic>
@@ -64,7 +65,10 @@ void serve(const NodeCommandOptions& o, communication::Task task) {
   slam.finish();
   const auto& ms = slam.mappingStats();
   const auto& ls = slam.loopStats();
-  report["end_of_run"] = done ? "completed" : "interrupted";
+  // Incomplete: an LC whose gateway left before its last snapshot, alone now.
+  report["end_of_run"] = !done ? "interrupted" : node.completed() ? "completed" : "incomplete";
+  if (done && !node.completed())
+    fmt::print(stderr, "warning: the gateway left before the end-of-run exchange completed; this node's map may lack its last snapshot\n");
   report["mapping"] = {{"keyframes_processed", ms.keyframes_processed}, {"points_created", ms.points_created},
                        {"keyframes_culled", ms.keyframes_culled}, {"local_bas", ms.local_bas},
                        {"local_bas_discarded", ms.local_bas_discarded}, {"local_bas_cut_short", ms.local_bas_cut_short}};

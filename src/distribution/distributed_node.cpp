@@ -192,8 +192,11 @@ void DistributedNode::onPeer(const PeerInfo& peer, bool present) {
       std::lock_guard lock(mutex_);
       ++departures_;
     }
-    handler_->afterIncoming([this, drop] {
+    // LC whose mapping node left: TR maps again, and is its gateway now.
+    const bool gateway_left = options_.task == Task::LoopClosing && peer.task == Task::Mapping;
+    handler_->afterIncoming([this, drop, gateway_left] {
       drop();
+      if (gateway_left) resendGlobalsToTracking();
       {
         std::lock_guard lock(mutex_);
         ++departures_handled_;
@@ -209,6 +212,31 @@ void DistributedNode::onPeer(const PeerInfo& peer, bool present) {
   // (or returns) gets them from the node that mapped until now, which gives mapping up to it.
   const Plan after = plan();
   if (newcomer && (after.local_maps || (before.mapping && !after.mapping))) sendMapsTo(peer);
+}
+
+std::optional<Task> DistributedNode::peerTask(uint16_t node) const {
+  std::lock_guard lock(mutex_);
+  if (auto it = peers_.find(node); it != peers_.end()) return it->second.task;
+  return std::nullopt;
+}
+
+void DistributedNode::resendGlobalsToTracking() {
+  uint16_t tracking = 0;
+  std::vector<std::pair<std::shared_ptr<core::Map>, uint64_t>> latest;
+  for (const auto& map : slam_.liveMaps()) {
+    std::lock_guard lock(mutex_);
+    if (auto it = published_.find(map->id); it != published_.end()) latest.emplace_back(map, it->second);
+  }
+  std::lock_guard lock(mutex_);
+  if (stopping_) return;
+  for (const auto& [id, peer] : peers_)
+    if (peer.task == Task::Tracking) tracking = id;
+  if (!tracking) return;
+  for (const auto& [map, epoch] : latest) {
+    spdlog::info("node {}: map {} of epoch {} sent again, to node {}, the new gateway", options_.id, map->id, epoch, tracking);
+    // A snapshot in full, once TR reads this topic (it began to when LM left).
+    handler_->sendGlobal(map, epoch, Topic::LcMap, {}, true, {tracking, {Topic::LcMap}});
+  }
 }
 
 void DistributedNode::sendMapsTo(const PeerInfo& peer) {
@@ -461,16 +489,42 @@ void DistributedNode::releaseHeld(core::Id map) {
 void DistributedNode::onControl(const Message& m, Topic topic) {
   const auto c = static_cast<Control>(m.target);
   if (c == Control::EndOfSequence) {
+    spdlog::info("node {}: end of the sequence, from node {}", options_.id, m.source);
     // Runs off the subscriber thread: finishing waits for queues that thread may feed. Made
     // under the lock: stop() takes the thread from another thread.
     std::lock_guard lock(mutex_);
     run_hosted_ = plan_.hosted;
-    if (finisher_.joinable() || stopping_) return;
+    if (stopping_) return;
+    // An LC answers every gateway that asks: after its gateway died, TR asks again as the new
+    // one, and reads this node's map topic only from then on (the first Done never reached it).
+    // The finisher that answered has nothing left to do once lc_answered_ is set: joined here.
+    if (options_.task == Task::LoopClosing && finisher_.joinable() && lc_answered_) finisher_.join();
+    if (finisher_.joinable()) return;
     if (options_.task == Task::LoopClosing) {
-      finisher_ = std::thread([this] {
+      lc_answered_ = false;
+      finisher_ = std::thread([this, asker = m.source] {
         slam_.drain();
+        // TR asks only as the gateway that took over from a dead LM, whose departure may not
+        // have reached this node yet: TR's last snapshot must find it in LC's latest epoch.
+        if (peerTask(asker) == Task::Tracking) resendGlobalsToTracking();
         while (!handler_->idle()) std::this_thread::sleep_for(std::chrono::milliseconds(5));
+        // A gateway that took over at the end (TR, after its LM died) began to read this topic
+        // only then: a Done written before its reader matched never reaches it (TR waited its
+        // 60 s for one, session 40). Bounded: a gateway that never reads is not waited for.
+        const auto until = std::chrono::steady_clock::now() + std::chrono::seconds(5);
+        while (!transport_.peerReads(Topic::LcMap, asker) && std::chrono::steady_clock::now() < until) {
+          {
+            std::lock_guard lock(mutex_);
+            if (stopping_) break;
+          }
+          std::this_thread::sleep_for(std::chrono::milliseconds(5));
+        }
         transport_.publish(Topic::LcMap, controlPacket(options_.id, Control::Done));
+        {
+          std::lock_guard lock(mutex_);
+          lc_answered_ = true;
+        }
+        changed_.notify_all();
       });
     } else {
       finisher_ = std::thread([this] { finishAsGateway(); });
@@ -507,12 +561,13 @@ void DistributedNode::answerMapRequest(const Message& m, Topic topic) {
   sendSnapshot(map, {m.source, {Topic::LmMap}});
 }
 
-void DistributedNode::finishAsGateway() {
+bool DistributedNode::finishAsGateway() {
   slam_.drain();
+  bool answered = true;
   if (plan().keyframes_to_lc) {
     publisher_->push({nullptr, nullptr, Topic::LmKeyframes, static_cast<uint8_t>(Control::EndOfSequence)});
     std::unique_lock lock(mutex_);
-    const bool answered = changed_.wait_for(lock, std::chrono::seconds(60), [&] { return lc_done_ || !plan_.keyframes_to_lc; });
+    answered = changed_.wait_for(lock, std::chrono::seconds(60), [&] { return lc_done_ || !plan_.keyframes_to_lc; }) && lc_done_;
     if (!answered) spdlog::warn("node {}: no Done from LC; sending the last snapshot anyway", options_.id);
   }
   while (!handler_->idle()) std::this_thread::sleep_for(std::chrono::milliseconds(5));
@@ -528,6 +583,7 @@ void DistributedNode::finishAsGateway() {
     done_ = true;
   }
   changed_.notify_all();
+  return answered;
 }
 
 bool DistributedNode::finishRun(std::chrono::milliseconds timeout) {
@@ -548,8 +604,15 @@ bool DistributedNode::finishRun(std::chrono::milliseconds timeout) {
         return done_ || (!plan_.keyframes_to_lm && departures_handled_ == departures_);
       }) && done_;
     }
-    if (!done && plan().mapping) slam_.drain();
-    return done;
+    if (done) return true;
+    const Plan now = plan();
+    if (!now.mapping) return false;  // timed out with the gateway still there
+    // The gateway left first, and this node maps again. With an LC left, it is the gateway now
+    // and finishes the exchange with it: the LC's map would otherwise end without the last
+    // snapshot, and its node would wait for a Done nobody sends.
+    if (now.local_maps) return finishAsGateway();
+    slam_.drain();
+    return false;
   } else if (p.local_maps) {
     finishAsGateway();  // this node maps: it is the gateway
   } else {
@@ -561,7 +624,15 @@ bool DistributedNode::finishRun(std::chrono::milliseconds timeout) {
 
 bool DistributedNode::waitUntilDone(std::chrono::milliseconds timeout) {
   std::unique_lock lock(mutex_);
-  return changed_.wait_for(lock, timeout, [&] { return done_; });
+  // Alone once the departures are handled: a Done sent just before leaving is in by then.
+  return changed_.wait_for(lock, timeout, [&] {
+    return done_ || (lc_answered_ && peers_.empty() && departures_handled_ == departures_);
+  });
+}
+
+bool DistributedNode::completed() const {
+  std::lock_guard lock(mutex_);
+  return done_;
 }
 
 void DistributedNode::stop() {

@@ -7,6 +7,9 @@
 // it has, forwards it to LC; LC finishes its queue and answers Done; LM then sends a last full
 // snapshot of its maps and Done on its map topic. A node is finished when it has that Done:
 // from then on every node's S_full holds the same keyframes and points (eventual consistency).
+// A gateway that dies before its Done: TR stops waiting for it and, with mapping back and an
+// LC left, runs the gateway's part itself (LC answers each gateway that asks); an LC that has
+// answered and is left alone ends without the Done.
 //
 // Hand-over: a node that joins the network gets the maps so far as a full snapshot, from the
 // gateway (a late LC) or from the node that mapped until it came (an LM that joins or returns
@@ -23,6 +26,7 @@
 #include <memory>
 #include <mutex>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <thread>
 #include <vector>
 
@@ -51,10 +55,15 @@ class DistributedNode final : public core::SystemEvents {
   // Joins the network and applies the policy to the peers found so far.
   void start();
   // TR: after the last frame, runs the end-of-run exchange (bounded by `timeout`). Returns
-  // whether the Done came back.
+  // whether it completed: the Done came back or, when the gateway left before sending it and
+  // an LC remains, this node finished the exchange with the LC as its gateway.
   bool finishRun(std::chrono::milliseconds timeout);
-  // LM and LC: blocks until the end-of-run exchange is over (or `timeout`).
+  // LM and LC: blocks until the end-of-run exchange is over (or `timeout`). Over also for an
+  // LC that has answered its Done and is left alone: its gateway left before sending the last
+  // snapshot, and nobody is left to send one (see completed()).
   bool waitUntilDone(std::chrono::milliseconds timeout);
+  // Whether the gateway's Done came (this node's own, on the gateway).
+  bool completed() const;
   // Leaves the network (after the exchange).
   void stop();
 
@@ -84,9 +93,16 @@ class DistributedNode final : public core::SystemEvents {
   void applyPlan();
   void onGlobal(std::vector<MapRecord>&& batches, communication::Topic topic);
   void onControl(const communication::Message& m, communication::Topic topic);
-  void finishAsGateway();
+  // The gateway's part of the end of a run. Returns whether the LC (if any) answered.
+  bool finishAsGateway();
   // A newcomer gets this node's maps so far (see Hand-over above).
   void sendMapsTo(const communication::PeerInfo& peer);
+  // LC, once its mapping node has left: the global maps that node had not relayed yet never
+  // reach TR, which maps again as the new gateway. Its maps would stay in an older epoch, and
+  // LC ignores all TR labels with that, the last snapshot included (LC ended 79 points short
+  // of TR, session 40). So LC sends its latest global state of each map to TR again.
+  void resendGlobalsToTracking();
+  std::optional<communication::Task> peerTask(uint16_t node) const;
   // A full snapshot of `map` with its keyframes' features, for `newcomer` (a hand-over, or a
   // node that asked for a map it missed).
   void sendSnapshot(const std::shared_ptr<core::Map>& map, Newcomer newcomer);
@@ -125,6 +141,7 @@ class DistributedNode final : public core::SystemEvents {
   mutable std::map<core::Id, std::chrono::steady_clock::time_point> unanswered_;
   std::vector<MapRecord> held_;             // local maps ahead of synced_, in arrival order
   bool done_ = false, lc_done_ = false;
+  bool lc_answered_ = false;  // LC: its Done went to the gateway that asked last
   bool stopping_ = false;  // stop() has begun: no finisher may start any more
   uint8_t run_hosted_ = 0;  // what it ran when the sequence ended (before peers leave)
   int globals_ignored_ = 0;

@@ -1,4 +1,4 @@
-// A tracking node and its peers, with the peer events scripted.
+// A tracking node (and a loop-closing node) and its peers, with the peer events scripted.
 //
 // Mutual discovery: a tracking node counts a peer as there for it only once the peer has heard
 // it too (PeerInfo::seen) and, for a mapping peer, reads its keyframes. Discovery is one-sided:
@@ -7,12 +7,16 @@
 //
 // End of run: the Done comes from the gateway; a gateway that leaves first sends none, and TR
 // must not wait out its whole timeout for it (over a slow link it waited 120 s, session 39).
+// With an LC left, TR finishes the exchange with it as the new gateway; an LC that has answered
+// and is left alone ends too (it waited for the Done until killed, session 40).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <array>
 #include <atomic>
 #include <future>
 #include <mutex>
+#include <thread>
 
 #include "core/camera/pinhole_radtan.hpp"
 #include "core/system/slam_system.hpp"
@@ -41,13 +45,20 @@ class ScriptedTransport final : public communication::Transport {
     std::lock_guard lock(mutex_);
     announced_ = self;
   }
-  void publish(Topic, communication::Message&&) override {}
+  void publish(Topic topic, communication::Message&& m) override {
+    if (m.kind != static_cast<uint8_t>(PacketKind::Control)) return;
+    std::lock_guard lock(mutex_);
+    controls_.push_back({topic, static_cast<Control>(m.target)});
+  }
   void subscribe(Topic topic, Handler handler) override {
     std::lock_guard lock(mutex_);
     handlers_[static_cast<size_t>(topic)] = std::move(handler);
   }
   void unsubscribe(Topic) override {}
-  bool peerReads(Topic topic, uint16_t node) override { return node == 2 && topic == Topic::TrKeyframes && lm_reads; }
+  bool peerReads(Topic topic, uint16_t node) override {
+    return (node == 2 && topic == Topic::TrKeyframes && lm_reads) || (node == 3 && topic == Topic::LmKeyframes) ||
+           topic == Topic::LcMap;
+  }
   void stop() override {}
   communication::TrafficReport traffic() const override { return {}; }
 
@@ -66,9 +77,22 @@ class ScriptedTransport final : public communication::Transport {
     std::lock_guard lock(mutex_);
     return announced_.seen;
   }
+  // Waits until the node has published `count` control packets `c` on `topic`.
+  bool published(Topic topic, Control c, int count = 1, std::chrono::seconds within = std::chrono::seconds(30)) {
+    const auto until = std::chrono::steady_clock::now() + within;
+    while (std::chrono::steady_clock::now() < until) {
+      {
+        std::lock_guard lock(mutex_);
+        if (std::count(controls_.begin(), controls_.end(), std::pair{topic, c}) >= count) return true;
+      }
+      std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    }
+    return false;
+  }
 
  private:
   std::mutex mutex_;
+  std::vector<std::pair<Topic, Control>> controls_;
   PeerInfo announced_;
   PeerHandler on_peer_;
   std::array<Handler, communication::kTopicCount> handlers_;
@@ -84,18 +108,24 @@ PeerInfo peerInfo(uint16_t node, Task task, std::vector<uint16_t> seen) {
   return p;
 }
 
-// A tracking node with no frames, on a scripted transport.
+// A node with no frames, on a scripted transport: TR (id 1) by default, or LC (id 3), which
+// has no camera, as `hiveslam node --task lc` has none.
 struct TrackingNode {
-  std::shared_ptr<camera::PinholeRadTan> camera =
-      std::make_shared<camera::PinholeRadTan>(752, 480, 458.0, 457.0, 367.0, 248.0);
-  core::SlamSystem slam{core::SlamSettings{}, camera, core::SlamSystem::Mode::Offline, nullptr, 1};
-  ScriptedTransport transport;
-  DistributedNode node{slam, transport, {Task::Tracking, 1, "tr", {}}};
-  TrackingNode() { node.start(); }
+  explicit TrackingNode(Task task = Task::Tracking)
+      : slam{core::SlamSettings{}, task == Task::Tracking ? camera : nullptr, core::SlamSystem::Mode::Offline, nullptr,
+             task == Task::Tracking ? uint16_t{1} : uint16_t{3}},
+        node{slam, transport, {task, task == Task::Tracking ? uint16_t{1} : uint16_t{3}, communication::taskName(task), {}}} {
+    node.start();
+  }
   ~TrackingNode() {
     node.stop();
     slam.finish();
   }
+  std::shared_ptr<camera::PinholeRadTan> camera =
+      std::make_shared<camera::PinholeRadTan>(752, 480, 458.0, 457.0, 367.0, 248.0);
+  core::SlamSystem slam;
+  ScriptedTransport transport;
+  DistributedNode node;
 };
 
 TEST(MutualDiscovery, ATrackingNodeWaitsForPeersThatHaveHeardItAndAMappingPeerThatReadsItsKeyframes) {
@@ -158,6 +188,57 @@ TEST(EndOfRun, ADoneSentBeforeTheGatewayLeftCountsThoughTheNoticeCameFirst) {
   tr.transport.peer(peerInfo(2, Task::Mapping, {1}), false);
   ASSERT_EQ(finished.wait_for(std::chrono::minutes(1)), std::future_status::ready);
   EXPECT_TRUE(finished.get());
+}
+
+// LM leaves after TR's EndOfSequence, before its Done; LC stays. TR, mapping again, asks LC
+// for its Done as the new gateway and ends with the exchange completed.
+TEST(EndOfRun, ATrackingNodeWhoseGatewayLeftFinishesTheRunWithTheLoopClosingNode) {
+  TrackingNode tr;
+  tr.transport.lm_reads = true;
+  tr.transport.peer(peerInfo(3, Task::LoopClosing, {1, 2}), true);
+  tr.transport.peer(peerInfo(2, Task::Mapping, {1, 3}), true);
+  ASSERT_TRUE(tr.node.plan().keyframes_to_lm);
+  auto finished = std::async(std::launch::async, [&] { return tr.node.finishRun(std::chrono::minutes(10)); });
+  ASSERT_TRUE(tr.transport.published(Topic::TrKeyframes, Control::EndOfSequence));
+  tr.transport.peer(peerInfo(2, Task::Mapping, {1, 3}), false);
+  ASSERT_TRUE(tr.transport.published(Topic::LmKeyframes, Control::EndOfSequence)) << "TR did not ask LC to finish";
+  EXPECT_TRUE(tr.node.plan().local_maps) << "TR is the gateway now";
+  EXPECT_EQ(finished.wait_for(std::chrono::milliseconds(300)), std::future_status::timeout) << "LC has not answered";
+  tr.transport.deliver(Topic::LcMap, controlPacket(3, Control::Done));
+  ASSERT_EQ(finished.wait_for(std::chrono::minutes(1)), std::future_status::ready);
+  EXPECT_TRUE(finished.get());
+  EXPECT_TRUE(tr.transport.published(Topic::LmMap, Control::Done)) << "LC gets no Done from its new gateway";
+}
+
+// LC has answered LM's EndOfSequence; LM dies before its last snapshot and Done. While TR is
+// there LC waits (TR may finish as the gateway); TR asks again, LC answers again; and an LC
+// left alone ends without the Done, saying so.
+TEST(EndOfRun, ALoopClosingNodeAnswersEachGatewayAndEndsWhenLeftAlone) {
+  TrackingNode lc(Task::LoopClosing);
+  lc.transport.peer(peerInfo(1, Task::Tracking, {2, 3}), true);
+  lc.transport.peer(peerInfo(2, Task::Mapping, {1, 3}), true);
+  lc.transport.deliver(Topic::LmKeyframes, controlPacket(2, Control::EndOfSequence));
+  ASSERT_TRUE(lc.transport.published(Topic::LcMap, Control::Done));
+  lc.transport.peer(peerInfo(2, Task::Mapping, {1, 3}), false);
+  EXPECT_FALSE(lc.node.waitUntilDone(std::chrono::milliseconds(300))) << "TR is still there";
+
+  lc.transport.deliver(Topic::LmKeyframes, controlPacket(1, Control::EndOfSequence));
+  ASSERT_TRUE(lc.transport.published(Topic::LcMap, Control::Done, 2)) << "no Done for the new gateway";
+  EXPECT_FALSE(lc.node.waitUntilDone(std::chrono::milliseconds(300)));
+  lc.transport.peer(peerInfo(1, Task::Tracking, {3}), false);
+  EXPECT_TRUE(lc.node.waitUntilDone(std::chrono::seconds(30))) << "alone, and still waiting for a Done";
+  EXPECT_FALSE(lc.node.completed());
+}
+
+TEST(EndOfRun, ALoopClosingNodeThatGotTheDoneHasCompleted) {
+  TrackingNode lc(Task::LoopClosing);
+  lc.transport.peer(peerInfo(2, Task::Mapping, {3}), true);
+  lc.transport.deliver(Topic::LmKeyframes, controlPacket(2, Control::EndOfSequence));
+  ASSERT_TRUE(lc.transport.published(Topic::LcMap, Control::Done));
+  lc.transport.deliver(Topic::LmMap, controlPacket(2, Control::Done));
+  lc.transport.peer(peerInfo(2, Task::Mapping, {3}), false);
+  EXPECT_TRUE(lc.node.waitUntilDone(std::chrono::seconds(30)));
+  EXPECT_TRUE(lc.node.completed());
 }
 
 }  // namespace
