@@ -212,6 +212,20 @@ void DistributedNode::onPeer(const PeerInfo& peer, bool present) {
   // (or returns) gets them from the node that mapped until now, which gives mapping up to it.
   const Plan after = plan();
   if (newcomer && (after.local_maps || (before.mapping && !after.mapping))) sendMapsTo(peer);
+  // TR, the gateway now that its LM left, and an LC: the keyframes LM had mapped but not yet
+  // sent on to LC never reach it (LC's S_full got their records from TR's last snapshot, its
+  // SLAM map never their features: a keyframe short of TR, session 40). The newcomer's snapshot
+  // brings the features of those it lacks.
+  if (!present && before.keyframes_to_lm && after.keyframes_to_lc)
+    for (const auto& lc : peersWith(Task::LoopClosing)) sendMapsTo(lc);
+}
+
+std::vector<PeerInfo> DistributedNode::peersWith(Task task) const {
+  std::lock_guard lock(mutex_);
+  std::vector<PeerInfo> out;
+  for (const auto& [id, p] : peers_)
+    if (p.task == task) out.push_back(p);
+  return out;
 }
 
 std::optional<Task> DistributedNode::peerTask(uint16_t node) const {
@@ -221,17 +235,16 @@ std::optional<Task> DistributedNode::peerTask(uint16_t node) const {
 }
 
 void DistributedNode::resendGlobalsToTracking() {
-  uint16_t tracking = 0;
   std::vector<std::pair<std::shared_ptr<core::Map>, uint64_t>> latest;
   for (const auto& map : slam_.liveMaps()) {
     std::lock_guard lock(mutex_);
     if (auto it = published_.find(map->id); it != published_.end()) latest.emplace_back(map, it->second);
   }
+  const auto trackers = peersWith(Task::Tracking);
+  if (trackers.empty()) return;
+  const uint16_t tracking = trackers.front().node;
   std::lock_guard lock(mutex_);
   if (stopping_) return;
-  for (const auto& [id, peer] : peers_)
-    if (peer.task == Task::Tracking) tracking = id;
-  if (!tracking) return;
   for (const auto& [map, epoch] : latest) {
     spdlog::info("node {}: map {} of epoch {} sent again, to node {}, the new gateway", options_.id, map->id, epoch, tracking);
     // A snapshot in full, once TR reads this topic (it began to when LM left).

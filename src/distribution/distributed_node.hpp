@@ -103,6 +103,7 @@ class DistributedNode final : public core::SystemEvents {
   // of TR, session 40). So LC sends its latest global state of each map to TR again.
   void resendGlobalsToTracking();
   std::optional<communication::Task> peerTask(uint16_t node) const;
+  std::vector<communication::PeerInfo> peersWith(communication::Task task) const;
   // A full snapshot of `map` with its keyframes' features, for `newcomer` (a hand-over, or a
   // node that asked for a map it missed).
   void sendSnapshot(const std::shared_ptr<core::Map>& map, Newcomer newcomer);
