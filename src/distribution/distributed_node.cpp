@@ -90,6 +90,10 @@ DistributedNode::DistributedNode(core::SlamSystem& slam, communication::Transpor
   hooks.settled = [this] { return plan().mapping || slam_.mappingIdle(); };
   handler_ = std::make_unique<MapHandler>(transport_, integrator_, observer_, ledger_, options_.settings, options_.id,
                                           std::move(hooks));
+  integrator_.setDeparted([this](uint16_t node) {
+    std::lock_guard lock(departed_mutex_);
+    return departed_.count(node) > 0;
+  });
   slam_.setEvents(this);
   slam_.setRemoteMapping([this] { return remoteIdle(); }, [this] { remoteWait(); });
 }
@@ -166,9 +170,17 @@ void DistributedNode::onPeer(const PeerInfo& peer, bool present) {
       newcomer = it == peers_.end() || it->second.incarnation != peer.incarnation;
       restarted = it != peers_.end() && newcomer;
       peers_[peer.node] = peer;
+      had_mapping_peer_ = had_mapping_peer_ || peer.task == Task::Mapping;
     } else {
       peers_.erase(peer.node);
     }
+  }
+  {
+    std::lock_guard lock(departed_mutex_);
+    if (present)
+      departed_.erase(peer.node);
+    else
+      departed_.insert(peer.node);
   }
   if (newcomer)
     gate_.joined(peer.node, peer.task);
@@ -226,6 +238,11 @@ std::vector<PeerInfo> DistributedNode::peersWith(Task task) const {
   for (const auto& [id, p] : peers_)
     if (p.task == task) out.push_back(p);
   return out;
+}
+
+bool DistributedNode::hadMappingPeer() const {
+  std::lock_guard lock(mutex_);
+  return had_mapping_peer_;
 }
 
 std::optional<Task> DistributedNode::peerTask(uint16_t node) const {
@@ -517,9 +534,10 @@ void DistributedNode::onControl(const Message& m, Topic topic) {
       lc_answered_ = false;
       finisher_ = std::thread([this, asker = m.source] {
         slam_.drain();
-        // TR asks only as the gateway that took over from a dead LM, whose departure may not
-        // have reached this node yet: TR's last snapshot must find it in LC's latest epoch.
-        if (peerTask(asker) == Task::Tracking) resendGlobalsToTracking();
+        // TR asking, where an LM was, is the gateway that took over from a dead LM, whose
+        // departure may not have reached this node yet: TR's last snapshot must find it in
+        // LC's latest epoch. (TR that was the gateway all along has every global map.)
+        if (peerTask(asker) == Task::Tracking && hadMappingPeer()) resendGlobalsToTracking();
         while (!handler_->idle()) std::this_thread::sleep_for(std::chrono::milliseconds(5));
         // A gateway that took over at the end (TR, after its LM died) began to read this topic
         // only then: a Done written before its reader matched never reaches it (TR waited its

@@ -99,9 +99,10 @@ class DistributedNode final : public core::SystemEvents {
   void sendMapsTo(const communication::PeerInfo& peer);
   // LC, once its mapping node has left: the global maps that node had not relayed yet never
   // reach TR, which maps again as the new gateway. Its maps would stay in an older epoch, and
-  // LC ignores all TR labels with that, the last snapshot included (LC ended 79 points short
-  // of TR, session 40). So LC sends its latest global state of each map to TR again.
+  // LC ignores everything TR labels with that epoch, the last snapshot included (LC ended 79
+  // points short of TR, session 40). So LC sends its latest global state of each map to TR.
   void resendGlobalsToTracking();
+  bool hadMappingPeer() const;
   std::optional<communication::Task> peerTask(uint16_t node) const;
   std::vector<communication::PeerInfo> peersWith(communication::Task task) const;
   // A full snapshot of `map` with its keyframes' features, for `newcomer` (a hand-over, or a
@@ -143,6 +144,7 @@ class DistributedNode final : public core::SystemEvents {
   std::vector<MapRecord> held_;             // local maps ahead of synced_, in arrival order
   bool done_ = false, lc_done_ = false;
   bool lc_answered_ = false;  // LC: its Done went to the gateway that asked last
+  bool had_mapping_peer_ = false;  // a mapping node was among the peers at some point
   bool stopping_ = false;  // stop() has begun: no finisher may start any more
   uint8_t run_hosted_ = 0;  // what it ran when the sequence ended (before peers leave)
   int globals_ignored_ = 0;
@@ -155,6 +157,10 @@ class DistributedNode final : public core::SystemEvents {
   uint64_t knownEpoch(core::Id map) const;  // the newer of synced_ and published_; mutex_ held
   void releaseHeld(core::Id map);           // applies the held local maps the epoch has reached
   std::thread finisher_;  // the end-of-run exchange (LM, LC)
+  // Peers that left and have not come back (StateIntegrator::setDeparted). Its own lock, taken
+  // last: the integrator asks with a map's mutex held.
+  mutable std::mutex departed_mutex_;
+  std::set<uint16_t> departed_;
 };
 
 }  // namespace hiveslam::distribution

@@ -513,7 +513,11 @@ bool StateIntegrator::applyGlobal(const std::vector<MapRecord>& batches, bool au
     ids.insert(ids.end(), point_ids.begin(), point_ids.end());
     const auto newest = newestByNode(ids), newest_keyframe = newestByNode(kf_ids);
     const auto keyframe_known = [&](Id id) { return olderThanSnapshot(id, newest_keyframe); };
-    const auto point_known = [&](Id id) { return olderThanSnapshot(id, newest); };
+    // - A point of a node that has left: all it ever sends is in (a mapping node that died
+    //   left points at LC that TR, the gateway after it, never got: one more at LC, session 40).
+    const auto point_known = [&](Id id) {
+      return olderThanSnapshot(id, newest) || departed_(core::IdGenerator::node(id));
+    };
     const std::unordered_set<Id> kfs(kf_ids.begin(), kf_ids.end()), pts(point_ids.begin(), point_ids.end());
     std::vector<core::KeyFrame*> gone_kfs;
     for (const auto& [id, k] : map->keyframes)

@@ -13,6 +13,7 @@
 // is carried into the current frame. Deciding that under the same lock as the correction
 // leaves no window in which a correction is applied but not yet known.
 #include <atomic>
+#include <functional>
 #include <map>
 #include <memory>
 #include <mutex>
@@ -67,6 +68,11 @@ class StateIntegrator {
   // caller treats it as an ignored update.
   bool applyGlobal(const std::vector<MapRecord>& batches, bool authoritative);
   uint64_t stalePointsCarried() const { return stale_points_carried_; }
+  // Whether a node has left the network (and not come back). An authoritative map spares the
+  // points its sender may not have heard of yet; a node that left sends none any more, so its
+  // points the sender lacks are erased like the rest. Set before the first map comes in; called
+  // with a map's mutex held, so it must take no lock of the caller's.
+  void setDeparted(std::function<bool(uint16_t node)> departed) { departed_ = std::move(departed); }
 
   // With the map's mutex held: the map is now in the frame of global epoch `label` (a global
   // map applied here, or made here and published as that epoch).
@@ -94,6 +100,7 @@ class StateIntegrator {
   bool current(const core::Map& map, uint64_t label) const;
   core::SlamSystem& slam_;
   Observer& observer_;
+  std::function<bool(uint16_t)> departed_ = [](uint16_t) { return false; };
   std::atomic<uint64_t> stale_points_carried_{0};
   // What a label stood for here: the core epoch, and each keyframe's scale() then (content of
   // that frame is rescaled by how much the map's scale changed around it since).

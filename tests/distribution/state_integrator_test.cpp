@@ -475,6 +475,29 @@ TEST_F(EpochLabels, AnAuthoritativeSnapshotErasesTheSameObjectsFromTheMapAndFrom
   EXPECT_TRUE(pointHere(100));
 }
 
+// The same snapshot without the last point, but with nothing newer of the point's node: the
+// sender may not have heard of the point yet, and it stays. Once that node has left, nothing of
+// it is on the way any more, and the point goes. (A mapping node that died left a point at LC
+// that TR, the gateway after it, never got: LC ended one point more than TR, session 40.)
+TEST_F(EpochLabels, AnAuthoritativeSnapshotErasesThePointsOfANodeThatLeftThatItsSenderNeverGot) {
+  constexpr Id kOrphan = 100 + kPoints - 1;
+  MapRecord g;
+  g.kind = MapRecord::Kind::Global;
+  g.map = kMap;
+  g.epoch = 1;
+  g.keyframes.push_back(keyframeRecord(kFirst, poseAt(0.0)));
+  g.keyframes.push_back(keyframeRecord(kSecond, poseAt(0.4)));
+  addPoints(g, kPoints - 1);
+  ASSERT_TRUE(integrator_.applyGlobal({g}, true));
+  EXPECT_TRUE(pointHere(kOrphan)) << "erased though its maker may still send it to the sender";
+  EXPECT_TRUE(observer_.hasPoint(kOrphan));
+  integrator_.setDeparted([](uint16_t node) { return node == core::IdGenerator::node(kOrphan); });
+  ASSERT_TRUE(integrator_.applyGlobal({g}, true));
+  EXPECT_FALSE(pointHere(kOrphan)) << "its maker left, and the snapshot's sender never got it";
+  EXPECT_FALSE(observer_.hasPoint(kOrphan));
+  EXPECT_TRUE(pointHere(100));
+}
+
 // The sender took its snapshot with the map's second keyframe still in its queue: it holds
 // the first keyframe and the points that keyframe brought, whose ids are newer than the second
 // keyframe's (tracking numbers a new map's two keyframes, then its points). Judged by the
