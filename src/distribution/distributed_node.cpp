@@ -240,32 +240,25 @@ std::vector<PeerInfo> DistributedNode::peersWith(Task task) const {
   return out;
 }
 
-bool DistributedNode::hadMappingPeer() const {
+bool DistributedNode::trackingTookOver(uint16_t asker) const {
   std::lock_guard lock(mutex_);
-  return had_mapping_peer_;
-}
-
-std::optional<Task> DistributedNode::peerTask(uint16_t node) const {
-  std::lock_guard lock(mutex_);
-  if (auto it = peers_.find(node); it != peers_.end()) return it->second.task;
-  return std::nullopt;
+  auto it = peers_.find(asker);
+  return had_mapping_peer_ && it != peers_.end() && it->second.task == Task::Tracking;
 }
 
 void DistributedNode::resendGlobalsToTracking() {
-  std::vector<std::pair<std::shared_ptr<core::Map>, uint64_t>> latest;
-  for (const auto& map : slam_.liveMaps()) {
-    std::lock_guard lock(mutex_);
-    if (auto it = published_.find(map->id); it != published_.end()) latest.emplace_back(map, it->second);
-  }
-  const auto trackers = peersWith(Task::Tracking);
-  if (trackers.empty()) return;
-  const uint16_t tracking = trackers.front().node;
+  const auto maps = slam_.liveMaps();
   std::lock_guard lock(mutex_);
   if (stopping_) return;
-  for (const auto& [map, epoch] : latest) {
-    spdlog::info("node {}: map {} of epoch {} sent again, to node {}, the new gateway", options_.id, map->id, epoch, tracking);
+  auto tr = std::find_if(peers_.begin(), peers_.end(), [](const auto& p) { return p.second.task == Task::Tracking; });
+  if (tr == peers_.end()) return;
+  for (const auto& map : maps) {
+    auto it = published_.find(map->id);
+    if (it == published_.end()) continue;
+    spdlog::info("node {}: map {} of epoch {} sent again, to node {}, the new gateway", options_.id, map->id, it->second,
+                 tr->first);
     // A snapshot in full, once TR reads this topic (it began to when LM left).
-    handler_->sendGlobal(map, epoch, Topic::LcMap, {}, true, {tracking, {Topic::LcMap}});
+    handler_->sendGlobal(map, it->second, Topic::LcMap, {}, true, {tr->first, {Topic::LcMap}});
   }
 }
 
@@ -534,10 +527,9 @@ void DistributedNode::onControl(const Message& m, Topic topic) {
       lc_answered_ = false;
       finisher_ = std::thread([this, asker = m.source] {
         slam_.drain();
-        // TR asking, where an LM was, is the gateway that took over from a dead LM, whose
-        // departure may not have reached this node yet: TR's last snapshot must find it in
-        // LC's latest epoch. (TR that was the gateway all along has every global map.)
-        if (peerTask(asker) == Task::Tracking && hadMappingPeer()) resendGlobalsToTracking();
+        // The LM's departure may not have reached this node yet: TR's last snapshot must
+        // find TR in LC's latest epoch.
+        if (trackingTookOver(asker)) resendGlobalsToTracking();
         while (!handler_->idle()) std::this_thread::sleep_for(std::chrono::milliseconds(5));
         // A gateway that took over at the end (TR, after its LM died) began to read this topic
         // only then: a Done written before its reader matched never reaches it (TR waited its

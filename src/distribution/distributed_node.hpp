@@ -26,7 +26,6 @@
 #include <memory>
 #include <mutex>
 #include <nlohmann/json.hpp>
-#include <optional>
 #include <thread>
 #include <vector>
 
@@ -102,8 +101,9 @@ class DistributedNode final : public core::SystemEvents {
   // LC ignores everything TR labels with that epoch, the last snapshot included (LC ended 79
   // points short of TR, session 40). So LC sends its latest global state of each map to TR.
   void resendGlobalsToTracking();
-  bool hadMappingPeer() const;
-  std::optional<communication::Task> peerTask(uint16_t node) const;
+  // LC: whether `asker` is TR asking as the gateway after an LM (a TR that was the gateway all
+  // along has every global map already).
+  bool trackingTookOver(uint16_t asker) const;
   std::vector<communication::PeerInfo> peersWith(communication::Task task) const;
   // A full snapshot of `map` with its keyframes' features, for `newcomer` (a hand-over, or a
   // node that asked for a map it missed).
