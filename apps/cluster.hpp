@@ -13,6 +13,7 @@ struct ClusterOptions {
   std::string dataset, out, config;
   bool realtime = false;
   bool no_loop_closing = false;
+  bool save_atlases = false;  // each node saves its maps to DIR/<task>/atlas.bin
   int domain = -1;  // -1: one picked from the process id (concurrent clusters stay apart)
   int timeout_seconds = 900;
   // The paper's feed: the dataset played as a ROS 2 image topic by a `hiveslam play` process,

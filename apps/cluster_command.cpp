@@ -82,6 +82,7 @@ ClusterResult runCluster(const ClusterOptions& o) {
     std::vector<std::string> args{"hiveslam", "node", "--task", task, "--domain", std::to_string(domain), "--out",
                                   (out / task).string()};
     args.insert(args.end(), common.begin(), common.end());
+    if (o.save_atlases) args.insert(args.end(), {"--atlas-out", (out / task / "atlas.bin").string()});
     services.emplace_back(task, spawn(args));
   }
   // TR's input: the dataset itself, or (feed_topic) an image topic that a player publishes.
@@ -111,6 +112,7 @@ ClusterResult runCluster(const ClusterOptions& o) {
   }
   if (o.realtime) tr.push_back("--realtime");
   tr.insert(tr.end(), common.begin(), common.end());
+  if (o.save_atlases) tr.insert(tr.end(), {"--atlas-out", (out / "tr" / "atlas.bin").string()});
   const pid_t tr_pid = spawn(tr);
   pid_t player = 0;
   if (o.feed_topic)  // the player waits for TR's reader, which TR makes once its peers are there
@@ -142,6 +144,7 @@ void addClusterCommand(CLI::App& app) {
   cmd->add_option("--domain", o->domain, "DDS domain id (default: picked from the process id)");
   cmd->add_flag("--realtime", o->realtime, "Feed frames at their timestamps");
   cmd->add_flag("--no-loop-closing", o->no_loop_closing, "Switch loop closing off");
+  cmd->add_flag("--atlases", o->save_atlases, "Each node saves its maps to DIR/<task>/atlas.bin (hiveslam run --atlas-in reads them)");
   cmd->add_flag("--feed-topic", o->feed_topic, "Play the dataset as a ROS 2 image topic to TR (the paper's set-up)");
   cmd->callback([o]() {
     const auto r = runCluster(*o);

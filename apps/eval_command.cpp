@@ -70,6 +70,8 @@ void printStats(const std::string& title, const eval::ErrorStats& s, const std::
 void addSplit(CLI::App* cmd, eval::StretchSplit& split) {
   cmd->add_option("--before", split.before, "First stretch: up to this many seconds into the run")->required();
   cmd->add_option("--after", split.after, "Second stretch: from this many seconds into the run")->required();
+  cmd->add_option("--first-from", split.first_from, "First stretch: from this many seconds into the run (default: the start)");
+  cmd->add_option("--second-until", split.second_until, "Second stretch: up to this many seconds into the run (default: the end)");
 }
 
 // The map with the most keyframes, or the one asked for.

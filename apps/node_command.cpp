@@ -17,6 +17,7 @@
 #include "core/system/slam_system.hpp"
 #include "distribution/distributed_node.hpp"
 #include "eval/resource_monitor.hpp"
+#include "io/atlas_file.hpp"
 #include "io/slam_settings_io.hpp"
 #include "io/vocabulary_file.hpp"
 
@@ -28,7 +29,7 @@ std::atomic<bool> g_stop{false};
 extern "C" void onSignal(int) { g_stop = true; }
 
 struct NodeCommandOptions {
-  std::string task = "tr", name, dataset, out, config, times, expect, topic, calibration, ground_truth;
+  std::string task = "tr", name, dataset, out, config, times, expect, topic, calibration, ground_truth, atlas_out;
   int domain = 0, id = 0;
   bool realtime = false, no_loop_closing = false;
   int wait_seconds = 20;
@@ -96,6 +97,7 @@ void serve(const NodeCommandOptions& o, communication::Task task) {
   report["peak_rss_mb"] = eval::ResourceMonitor::peakRssBytes() / 1048576.0;
   std::filesystem::create_directories(o.out);
   std::ofstream(std::filesystem::path(o.out) / "report.json") << report.dump(2) << "\n";
+  if (!o.atlas_out.empty()) io::saveAtlas(o.atlas_out, slam.liveMaps());
   fmt::print("node {} ({}): {} keyframes mapped, {} loops, {} merges, {:.1f} s CPU, {:.2f} Mbps\n", id,
              communication::taskName(task), ms.keyframes_processed, ls.loops, ls.merges, monitor.cpuSeconds(),
              report["bandwidth_mbps"].get<double>());
@@ -121,6 +123,7 @@ void addNodeCommand(CLI::App& app) {
   cmd->add_option("--times", o->times, "TR: times file for image folders and videos");
   cmd->add_flag("--realtime", o->realtime, "TR: feed frames at their timestamps");
   cmd->add_flag("--no-loop-closing", o->no_loop_closing, "Switch loop closing off");
+  cmd->add_option("--atlas-out", o->atlas_out, "Save the node's maps (its S_full) to an atlas file after the run");
   cmd->callback([o]() {
     communication::Task task;
     if (!communication::parseTask(o->task, task)) throw InputError("unknown task '" + o->task + "' (tr, lm or lc)");
@@ -143,6 +146,7 @@ void addNodeCommand(CLI::App& app) {
     run.topic_domain = o->domain;
     run.ground_truth = o->ground_truth;
     run.no_loop_closing = o->no_loop_closing;
+    run.atlas_out = o->atlas_out;
     run.network.enabled = true;
     run.network.domain = o->domain;
     run.network.id = o->id > 0 ? static_cast<uint16_t>(o->id) : 1;

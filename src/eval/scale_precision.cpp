@@ -57,8 +57,8 @@ ScalePrecision computeScalePrecision(const core::BaProblem& problem, const std::
   std::vector<size_t> first, second;
   const double t0 = stamps.empty() ? 0.0 : *std::min_element(stamps.begin(), stamps.end());
   for (size_t i = 0; i < stamps.size(); ++i) {
-    if (stamps[i] - t0 <= options.split.before) first.push_back(i);
-    if (stamps[i] - t0 >= options.split.after) second.push_back(i);
+    if (options.split.inFirst(stamps[i] - t0)) first.push_back(i);
+    if (options.split.inSecond(stamps[i] - t0)) second.push_back(i);
   }
   out.first_keyframes = first.size();
   out.second_keyframes = second.size();

@@ -31,10 +31,10 @@ ScaleStep computeScaleStep(const io::Trajectory& ref, const io::Trajectory& est,
   for (size_t i = 0; i < pair.est.size(); ++i) {
     const double t = pair.est.stamps[i] - t0;
     const Eigen::Vector3d pe = pair.est.poses[i].translation(), pr = pair.ref.poses[i].translation();
-    if (t <= split.before) {
+    if (split.inFirst(t)) {
       est1.push_back(pe);
       ref1.push_back(pr);
-    } else if (t >= split.after) {
+    } else if (split.inSecond(t)) {
       est2.push_back(pe);
       ref2.push_back(pr);
     }

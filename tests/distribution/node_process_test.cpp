@@ -11,6 +11,7 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
+#include "io/atlas_file.hpp"
 #include "synth/sequence.hpp"
 #include "temp_dir.hpp"
 
@@ -109,6 +110,37 @@ void expectSameMaps(const nlohmann::json& tr, const nlohmann::json& lm, const nl
   expectSFullInMap(lc, "lc");
 }
 
+// Each node's saved maps (cluster --atlases): every keyframe and point in all three, each where
+// TR has it to within 1 mm. The reports compare counts; this compares the poses themselves.
+void expectSamePoses(const fs::path& out) {
+  const auto tr = io::loadAtlas(out / "tr" / "atlas.bin");
+  ASSERT_FALSE(tr.empty());
+  for (const char* node : {"lm", "lc"}) {
+    const auto other = io::loadAtlas(out / node / "atlas.bin");
+    ASSERT_EQ(other.size(), tr.size()) << node;
+    for (const auto& m : tr) {
+      const auto it = std::find_if(other.begin(), other.end(), [&](const auto& o) { return o->id == m->id; });
+      ASSERT_NE(it, other.end()) << node << " lacks map " << m->id;
+      const core::Map& o = **it;
+      ASSERT_EQ(o.keyframes.size(), m->keyframes.size()) << node;
+      ASSERT_EQ(o.points.size(), m->points.size()) << node;
+      double worst_kf = 0, worst_point = 0;
+      for (const auto& [id, kf] : m->keyframes) {
+        const auto k = o.keyframes.find(id);
+        ASSERT_NE(k, o.keyframes.end()) << node << " lacks keyframe " << id;
+        worst_kf = std::max(worst_kf, (k->second->center() - kf->center()).norm());
+      }
+      for (const auto& [id, p] : m->points) {
+        const auto q = o.points.find(id);
+        ASSERT_NE(q, o.points.end()) << node << " lacks point " << id;
+        worst_point = std::max(worst_point, (q->second->position - p->position).norm());
+      }
+      EXPECT_LT(worst_kf, 1e-3) << node;
+      EXPECT_LT(worst_point, 1e-3) << node;
+    }
+  }
+}
+
 // The same maps, and TR's trajectory right.
 void expectOneMap(const nlohmann::json& tr, const nlohmann::json& lm, const nlohmann::json& lc) {
   expectSameMaps(tr, lm, lc);
@@ -179,7 +211,7 @@ std::string nodeEvents(const fs::path& out) {
 
 TEST(NodeProcesses, ThreeNodesOverLoopback) {
   testing::TempDir out;
-  const std::string cmd = std::string(HIVESLAM_BINARY) + " cluster --nodes 3 " + sequence().string() + " --out " +
+  const std::string cmd = std::string(HIVESLAM_BINARY) + " cluster --nodes 3 --atlases " + sequence().string() + " --out " +
                           out.path().string() + " > " + (out / "log").string() + " 2>&1";
   ASSERT_EQ(std::system(cmd.c_str()), 0) << std::ifstream(out / "log").rdbuf();
   EXPECT_TRUE(fs::exists(out / "trajectory.tum"));
@@ -203,6 +235,7 @@ TEST(NodeProcesses, ThreeNodesOverLoopback) {
   expectSFullInMap(tr, "tr");
   expectSFullInMap(lm, "lm");
   expectSFullInMap(lc, "lc");
+  expectSamePoses(out.path());
 }
 
 TEST(NodeProcesses, OneNodeIsTheStandaloneSystem) {

@@ -46,6 +46,30 @@ TEST(ScaleStep, MeasuresTheStepOfAPathScaledAfterItsTurn) {
   EXPECT_NEAR(computeScaleStep(truth, truth, {8.0, 12.0}).step(), 1.0, 1e-12);
 }
 
+// A merged map's two sides need not be the run's two ends: the bounds pick the middle stretches.
+// Here the path's last 4 s are scaled by another 5% (about the 16 s point), which bounded
+// stretches leave out and unbounded ones would take in.
+TEST(ScaleStep, BoundedStretchesLeaveTheRestOfThePathOut) {
+  const io::Trajectory truth = lPath();
+  const Eigen::Vector3d corner(3, 0, 1), late(3, 1.8, 1);
+  io::Trajectory est;
+  for (size_t i = 0; i < truth.size(); ++i) {
+    Eigen::Vector3d p = truth.poses[i].translation();
+    const double t = truth.stamps[i] - 100.0;
+    if (t > 16) p = late + 1.05 * (p - late);
+    if (t > 10) p = corner + 1.02 * (p - corner);
+    est.add(truth.stamps[i], at(p));
+  }
+  StretchSplit split{8.0, 12.0};
+  split.first_from = 2.0;
+  split.second_until = 16.0;
+  const ScaleStep s = computeScaleStep(truth, est, split);
+  EXPECT_NEAR(s.step(), 1.02, 1e-9);
+  EXPECT_EQ(s.first_poses, 61u);
+  EXPECT_EQ(s.second_poses, 41u);
+  EXPECT_GT(std::abs(computeScaleStep(truth, est, {8.0, 12.0}).step() - 1.02), 0.005);
+}
+
 TEST(ScaleStep, AStretchWithoutPosesIsAnInputError) {
   const io::Trajectory truth = lPath();
   EXPECT_THROW(computeScaleStep(truth, truth, {8.0, 30.0}), InputError);
