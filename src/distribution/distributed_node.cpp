@@ -76,8 +76,12 @@ DistributedNode::DistributedNode(core::SlamSystem& slam, communication::Transpor
   hooks.local_applied = [this](const MapRecord& m) {
     {
       std::lock_guard lock(mutex_);
+      const auto now = std::chrono::steady_clock::now();
       for (core::Id k : m.mapped) {
-        outstanding_.erase(k);
+        if (auto it = outstanding_.find(k); it != outstanding_.end()) {
+          ack_ms_.push_back(std::chrono::duration<double, std::milli>(now - it->second).count());
+          outstanding_.erase(it);
+        }
         unanswered_.erase(k);
       }
     }
@@ -744,12 +748,19 @@ nlohmann::json DistributedNode::report(double seconds) const {
     j["maps_awaited"] = maps_awaited_;
     j["maps_asked_for"] = maps_asked_for_;
     j["keyframes_taken_back"] = keyframes_taken_back_;
+    if (!ack_ms_.empty()) j["keyframe_ack_ms"] = ackSummary(ack_ms_);
     j["stale_points_carried"] = integrator_.stalePointsCarried();
     j["peers"] = peers_.size();
   }
   j["s_full_keyframes"] = observer_.keyframeCount();
   j["s_full_keyframes_not_in_map"] = sFullKeyframesNotInMap();
   return j;
+}
+
+nlohmann::json DistributedNode::ackSummary(std::vector<double> ms) {
+  std::sort(ms.begin(), ms.end());
+  auto at = [&](double q) { return ms[std::min(ms.size() - 1, static_cast<size_t>(q * static_cast<double>(ms.size())))]; };
+  return {{"count", ms.size()}, {"median", at(0.5)}, {"p95", at(0.95)}, {"max", ms.back()}};
 }
 
 std::vector<core::Id> DistributedNode::sFullKeyframesNotInMap() const {

@@ -79,6 +79,8 @@ class DistributedNode final : public core::SystemEvents {
   // Keyframes of S_full that no live SLAM map holds: known here by their record only, without
   // the features to track against, match or correct them. Empty after a healthy run.
   std::vector<core::Id> sFullKeyframesNotInMap() const;
+  // Count, median, 95th percentile and max of keyframe round trips (report's keyframe_ack_ms).
+  static nlohmann::json ackSummary(std::vector<double> ms);
 
   // core::SystemEvents
   void mapCreated(const std::shared_ptr<core::Map>& map) override;
@@ -153,6 +155,9 @@ class DistributedNode final : public core::SystemEvents {
   int maps_awaited_ = 0;  // keyframes that waited for a hand-over
   int maps_asked_for_ = 0;  // of those, the ones whose map was asked for (Control::SendMap)
   int keyframes_taken_back_ = 0;  // unacknowledged keyframes mapped here after the LM left
+  // TR: each acknowledged keyframe's round trip, in ms (sent to mapped, as TR saw it): what
+  // decides how often TR may make a keyframe, and what a slow link stretches first.
+  std::vector<double> ack_ms_;
   int departures_ = 0, departures_handled_ = 0;  // peers that left; of those, handled in order
   uint64_t knownEpoch(core::Id map) const;  // the newer of synced_ and published_; mutex_ held
   void releaseHeld(core::Id map);           // applies the held local maps the epoch has reached

@@ -229,6 +229,12 @@ TEST(NodeProcesses, ThreeNodesOverLoopback) {
   EXPECT_EQ(lm.value("end_of_run", ""), "completed");
   EXPECT_EQ(lc.value("end_of_run", ""), "completed");
   EXPECT_EQ(tr.value("messages_dropped", -1), 0);
+  // Every keyframe's round trip to LM, as TR saw it.
+  ASSERT_TRUE(tr.contains("keyframe_ack_ms"));
+  EXPECT_GT(tr["keyframe_ack_ms"]["count"].get<int>(), 0);
+  EXPECT_LE(tr["keyframe_ack_ms"]["count"].get<int>(), tr.value("keyframes_published", 0));
+  EXPECT_GT(tr["keyframe_ack_ms"]["median"].get<double>(), 0.0);
+  EXPECT_LE(tr["keyframe_ack_ms"]["median"].get<double>(), tr["keyframe_ack_ms"]["max"].get<double>());
   // The same keyframes in S_full everywhere after the end-of-run exchange.
   EXPECT_EQ(tr.value("s_full_keyframes", 0), lm.value("s_full_keyframes", -1));
   EXPECT_EQ(lc.value("s_full_keyframes", 0), lm.value("s_full_keyframes", -1));

@@ -241,5 +241,16 @@ TEST(EndOfRun, ALoopClosingNodeThatGotTheDoneHasCompleted) {
   EXPECT_TRUE(lc.node.completed());
 }
 
+TEST(KeyframeAcks, TheReportSummarizesTheRoundTripsByRank) {
+  std::vector<double> ms;
+  for (int i = 100; i >= 1; --i) ms.push_back(i);  // 1..100 ms, in any order
+  const auto j = DistributedNode::ackSummary(ms);
+  EXPECT_EQ(j["count"], 100);
+  EXPECT_DOUBLE_EQ(j["median"].get<double>(), 51.0);
+  EXPECT_DOUBLE_EQ(j["p95"].get<double>(), 96.0);
+  EXPECT_DOUBLE_EQ(j["max"].get<double>(), 100.0);
+  EXPECT_DOUBLE_EQ(DistributedNode::ackSummary({7.0})["p95"].get<double>(), 7.0);
+}
+
 }  // namespace
 }  // namespace hiveslam::distribution
