@@ -66,9 +66,10 @@ void serve(const NodeCommandOptions& o, communication::Task task) {
   slam.finish();
   const auto& ms = slam.mappingStats();
   const auto& ls = slam.loopStats();
-  // Incomplete: an LC whose gateway left before its last snapshot, alone now.
-  report["end_of_run"] = !done ? "interrupted" : node.completed() ? "completed" : "incomplete";
-  if (done && !node.completed())
+  // Incomplete: an LC whose gateway left before its last snapshot, alone now. Released: TR's
+  // link was too slow, and TR went on alone (its map is the run's map).
+  report["end_of_run"] = !done ? "interrupted" : node.released() ? "released" : node.completed() ? "completed" : "incomplete";
+  if (done && !node.completed() && !node.released())
     fmt::print(stderr, "warning: the gateway left before the end-of-run exchange completed; this node's map may lack its last snapshot\n");
   report["mapping"] = {{"keyframes_processed", ms.keyframes_processed}, {"points_created", ms.points_created},
                        {"keyframes_culled", ms.keyframes_culled}, {"local_bas", ms.local_bas},

@@ -36,7 +36,9 @@ uint64_t firstIdCounter(std::chrono::system_clock::time_point start) {
 
 DistributedNode::DistributedNode(core::SlamSystem& slam, communication::Transport& transport, NodeOptions options)
     : slam_(slam), transport_(transport), options_(std::move(options)), integrator_(slam, observer_),
-      gate_(transport, std::chrono::milliseconds(options_.settings.handover_wait_ms)) {
+      gate_(transport, std::chrono::milliseconds(options_.settings.handover_wait_ms)),
+      watch_(std::chrono::milliseconds(options_.settings.release_slow_gateway_ms), options_.settings.release_slow_acks,
+             std::chrono::milliseconds(options_.settings.dead_peer_ms)) {
   publisher_ = std::make_unique<KeyframePublisher>(
       transport_, observer_, ledger_, options_.id, [this](Topic topic, core::Id point) {
         // TR's receiver (LM) has every point TR received from it; LM's (LC) those sent to it.
@@ -78,11 +80,23 @@ DistributedNode::DistributedNode(core::SlamSystem& slam, communication::Transpor
       std::lock_guard lock(mutex_);
       const auto now = std::chrono::steady_clock::now();
       for (core::Id k : m.mapped) {
-        if (auto it = outstanding_.find(k); it != outstanding_.end()) {
-          ack_ms_.push_back(std::chrono::duration<double, std::milli>(now - it->second).count());
-          outstanding_.erase(it);
+        // Local maps list their mapped keyframes again; only a first acknowledgement counts.
+        // Those no longer waited for (unanswered_) count too: on a slow link they are most.
+        auto it = outstanding_.find(k);
+        auto late = unanswered_.find(k);
+        if (it == outstanding_.end() && late == unanswered_.end()) continue;
+        const auto sent = it != outstanding_.end() ? it->second : late->second;
+        ack_ms_.push_back(std::chrono::duration<double, std::milli>(now - sent).count());
+        // Keyframes sent before a new gateway's first answer waited on its hand-over: their
+        // answers prove it alive, their round trips say nothing of the link.
+        if (handover_pending_) {
+          handover_pending_ = false;
+          judge_from_ = now;
         }
-        unanswered_.erase(k);
+        watch_.answered(sent >= judge_from_ ? now - sent : GatewayWatch::Clock::duration::zero());
+        lost_waiting_ = false;
+        if (it != outstanding_.end()) outstanding_.erase(it);
+        if (late != unanswered_.end()) unanswered_.erase(late);
       }
     }
     changed_.notify_all();
@@ -99,7 +113,12 @@ DistributedNode::DistributedNode(core::SlamSystem& slam, communication::Transpor
     return departed_.count(node) > 0;
   });
   slam_.setEvents(this);
-  slam_.setRemoteMapping([this] { return remoteIdle(); }, [this] { remoteWait(); });
+  slam_.setRemoteMapping(
+      [this] {
+        watchGateway();
+        return remoteIdle();
+      },
+      [this] { remoteWait(); });
 }
 
 DistributedNode::~DistributedNode() {
@@ -168,6 +187,13 @@ void DistributedNode::onPeer(const PeerInfo& peer, bool present) {
   const Plan before = plan();
   {
     std::lock_guard lock(mutex_);
+    // A node released here is gone for this node already: its announcements until the Release
+    // reaches it change nothing, and its leaving was counted at the release. Restarted (a new
+    // incarnation), it is a newcomer like any other.
+    if (present ? released_.count({peer.node, peer.incarnation}) > 0
+                : std::erase_if(released_, [&](const auto& r) { return r.first == peer.node; }) > 0 &&
+                      !peers_.count(peer.node))
+      return;
     leaving = stopping_;
     if (present) {
       auto it = peers_.find(peer.node);
@@ -227,6 +253,12 @@ void DistributedNode::onPeer(const PeerInfo& peer, bool present) {
   // A node that joins late gets the maps so far from the gateway; a mapping node that joins
   // (or returns) gets them from the node that mapped until now, which gives mapping up to it.
   const Plan after = plan();
+  if (newcomer && before.mapping && !after.mapping) {
+    // A gateway taking the map over answers nothing until it holds it (handover_wait_ms at
+    // most): it is not judged slow before its first answer (a restarted LM was released).
+    std::lock_guard lock(mutex_);
+    handover_pending_ = true;
+  }
   if (newcomer && (after.local_maps || (before.mapping && !after.mapping))) sendMapsTo(peer);
   // TR, the gateway now that its LM left, and an LC: the keyframes LM had mapped but not yet
   // sent on to LC never reach it (LC's S_full got their records from TR's last snapshot, its
@@ -335,6 +367,7 @@ void DistributedNode::applyPlan() {
       if (std::find(p.subscriptions.begin(), p.subscriptions.end(), t) == p.subscriptions.end()) remove.push_back(t);
     subscribed_ = p.subscriptions;
     if (!changed && add.empty() && remove.empty()) return;
+    lost_waiting_ = false;  // a loss under the old plan says nothing of a new gateway
     if (p.mapping && !before.mapping) {
       orphans.swap(outstanding_);
       orphans.insert(unanswered_.begin(), unanswered_.end());
@@ -377,11 +410,18 @@ void DistributedNode::mapCreated(const std::shared_ptr<core::Map>& map) {
   map->journal_on = true;
 }
 
+void DistributedNode::trackingLost() {
+  // Lost with keyframes waiting for their points: the round trip may have starved tracking.
+  std::lock_guard lock(mutex_);
+  if (plan_.keyframes_to_lm) lost_waiting_ = true;
+}
+
 void DistributedNode::keyframeCreated(const std::shared_ptr<core::Map>& map, const std::shared_ptr<core::KeyFrame>& kf) {
   if (!plan().keyframes_to_lm) return;
   {
     std::lock_guard lock(mutex_);
     outstanding_.emplace(kf->id, std::chrono::steady_clock::now());
+    watch_.sent(std::chrono::steady_clock::now());
   }
   publisher_->push({map, kf, Topic::TrKeyframes, kTargetLm});
 }
@@ -562,6 +602,16 @@ void DistributedNode::onControl(const Message& m, Topic topic) {
     answerMapRequest(m, topic);
     return;
   }
+  if (c == Control::Release) {
+    if (options_.task == Task::Tracking) return;
+    spdlog::warn("node {}: released by node {} (its link is too slow to offload to); leaving", options_.id, m.source);
+    {
+      std::lock_guard lock(mutex_);
+      released_by_ = true;
+    }
+    changed_.notify_all();
+    return;
+  }
   if (c == Control::Done) {
     {
       std::lock_guard lock(mutex_);
@@ -653,7 +703,7 @@ bool DistributedNode::waitUntilDone(std::chrono::milliseconds timeout) {
   std::unique_lock lock(mutex_);
   // Alone once the departures are handled: a Done sent just before leaving is in by then.
   return changed_.wait_for(lock, timeout, [&] {
-    return done_ || (lc_answered_ && peers_.empty() && departures_handled_ == departures_);
+    return done_ || released_by_ || (lc_answered_ && peers_.empty() && departures_handled_ == departures_);
   });
 }
 
@@ -662,14 +712,73 @@ bool DistributedNode::completed() const {
   return done_;
 }
 
+bool DistributedNode::released() const {
+  std::lock_guard lock(mutex_);
+  return released_by_;
+}
+
+void DistributedNode::watchGateway() {
+  // Only in real time does tracking starve: offline, it waits for the gateway instead.
+  if (slam_.mode() != core::SlamSystem::Mode::Realtime) return;
+  std::lock_guard lock(mutex_);
+  if (stopping_ || releaser_.joinable() || !plan_.keyframes_to_lm || handover_pending_) return;
+  const auto now = std::chrono::steady_clock::now();
+  const int slow_ms = options_.settings.release_slow_gateway_ms;
+  std::string why;
+  const auto starved = [&](const auto& waiting) {
+    return std::any_of(waiting.begin(), waiting.end(), [&](const auto& k) { return watch_.starved(now, k.second); });
+  };
+  if (lost_waiting_ && (starved(outstanding_) || starved(unanswered_)))
+    why = fmt::format("tracking lost with a keyframe unacknowledged for over {} ms",
+                      std::max(slow_ms, options_.settings.dead_peer_ms));
+  else if (!watch_.tooSlow(now))
+    return;
+  else if (watch_.slowInARow() > 0)
+    why = fmt::format("{} keyframe acknowledgements in a row took over {} ms", watch_.slowInARow(), slow_ms);
+  else
+    why = fmt::format("no keyframe acknowledged for {} ms",
+                      std::max(slow_ms * options_.settings.release_slow_acks, options_.settings.dead_peer_ms));
+  releaser_ = std::thread([this, why] { releasePeers(why); });
+}
+
+void DistributedNode::releasePeers(const std::string& why) {
+  std::vector<PeerInfo> gone;
+  {
+    std::lock_guard lock(mutex_);
+    if (stopping_ || peers_.empty()) return;
+    for (const auto& [id, p] : peers_) {
+      gone.push_back(p);
+      released_.insert({id, p.incarnation});
+      released_names_.push_back(p.name);
+    }
+    peers_.clear();
+  }
+  {
+    std::lock_guard lock(departed_mutex_);
+    for (const auto& p : gone) departed_.insert(p.node);
+  }
+  std::string names;
+  for (const auto& p : gone) {
+    gate_.left(p.node);
+    names += (names.empty() ? "" : ", ") + p.name;
+  }
+  spdlog::warn("node {}: {}: the link is too slow to offload; releasing {} and running alone", options_.id, why, names);
+  // LM reads TR's keyframe topic, LC the gateway's map topic (so does LM).
+  transport_.publish(Topic::TrKeyframes, controlPacket(options_.id, Control::Release));
+  transport_.publish(Topic::LmMap, controlPacket(options_.id, Control::Release));
+  applyPlan();  // alone: mapping and loop closing here, the unacknowledged keyframes mapped here
+}
+
 void DistributedNode::stop() {
-  std::thread finisher;
+  std::thread finisher, releaser;
   {
     std::lock_guard lock(mutex_);
     stopping_ = true;
     finisher = std::move(finisher_);
+    releaser = std::move(releaser_);
   }
   if (finisher.joinable()) finisher.join();
+  if (releaser.joinable()) releaser.join();
   gate_.stop();  // what is left goes out now: a peer that never matched is not waited for
   publisher_->finish();
   transport_.stop();
@@ -749,6 +858,7 @@ nlohmann::json DistributedNode::report(double seconds) const {
     j["maps_asked_for"] = maps_asked_for_;
     j["keyframes_taken_back"] = keyframes_taken_back_;
     if (!ack_ms_.empty()) j["keyframe_ack_ms"] = ackSummary(ack_ms_);
+    if (!released_names_.empty()) j["peers_released"] = released_names_;
     j["stale_points_carried"] = integrator_.stalePointsCarried();
     j["peers"] = peers_.size();
   }

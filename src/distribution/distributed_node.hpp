@@ -15,6 +15,11 @@
 // gateway (a late LC) or from the node that mapped until it came (an LM that joins or returns
 // after TR took mapping back). Its keyframes of those maps wait for the snapshot.
 //
+// Slow link: a tracking node whose gateway acknowledges its keyframes too late (GatewayWatch)
+// releases its peers (Control::Release) and runs alone from then on,
+// as the standalone system. It ignores them until they leave; a released node leaves the
+// network when the Release reaches it, and ends its run "released".
+//
 // Lost map: a node that gets keyframes of a map it does not hold, with no snapshot coming (the
 // packet that started the map was lost), asks the node that sends it keyframes for the map
 // (Control::SendMap) and gets the same snapshot a newcomer would.
@@ -31,6 +36,7 @@
 
 #include "communication/transport.hpp"
 #include "core/system/slam_system.hpp"
+#include "distribution/gateway_watch.hpp"
 #include "distribution/keyframe_publisher.hpp"
 #include "distribution/keyframe_subscriber.hpp"
 #include "distribution/map_handler.hpp"
@@ -63,6 +69,11 @@ class DistributedNode final : public core::SystemEvents {
   bool waitUntilDone(std::chrono::milliseconds timeout);
   // Whether the gateway's Done came (this node's own, on the gateway).
   bool completed() const;
+  // LM and LC: whether a tracking node released this node (its link was too slow to offload
+  // to). waitUntilDone() is over then too.
+  bool released() const;
+  // TR: gives up offloading (see Slow link above): `why` goes to the log.
+  void releasePeers(const std::string& why);
   // Leaves the network (after the exchange).
   void stop();
 
@@ -84,6 +95,7 @@ class DistributedNode final : public core::SystemEvents {
 
   // core::SystemEvents
   void mapCreated(const std::shared_ptr<core::Map>& map) override;
+  void trackingLost() override;
   void keyframeCreated(const std::shared_ptr<core::Map>& map, const std::shared_ptr<core::KeyFrame>& kf) override;
   void keyframeTriangulated(const std::shared_ptr<core::Map>& map, const std::shared_ptr<core::KeyFrame>& kf) override;
   void keyframeMapped(const std::shared_ptr<core::Map>& map, const std::shared_ptr<core::KeyFrame>& kf) override;
@@ -118,6 +130,9 @@ class DistributedNode final : public core::SystemEvents {
   void answerMapRequest(const communication::Message& m, communication::Topic topic);
   bool remoteIdle() const;
   void remoteWait() const;
+  // Tracking thread, each frame while mapping is remote: starts releasePeers() on its own
+  // thread once the gateway is too slow (GatewayWatch).
+  void watchGateway();
   communication::PeerInfo self() const;
 
   core::SlamSystem& slam_;
@@ -158,6 +173,14 @@ class DistributedNode final : public core::SystemEvents {
   // TR: each acknowledged keyframe's round trip, in ms (sent to mapped, as TR saw it): what
   // decides how often TR may make a keyframe, and what a slow link stretches first.
   std::vector<double> ack_ms_;
+  GatewayWatch watch_;  // TR: how its gateway answers
+  bool lost_waiting_ = false;  // TR: tracking was lost since the gateway's last answer
+  bool handover_pending_ = false;  // TR: its new gateway has not answered since taking the map
+  GatewayWatch::Clock::time_point judge_from_{};  // TR: round trips of keyframes sent since
+  std::set<std::pair<uint16_t, uint64_t>> released_;  // TR: (node, incarnation) it released
+  std::vector<std::string> released_names_;           // TR: for the report
+  std::thread releaser_;      // TR: runs releasePeers() off the tracking thread
+  bool released_by_ = false;  // LM, LC: a tracking node released this node
   int departures_ = 0, departures_handled_ = 0;  // peers that left; of those, handled in order
   uint64_t knownEpoch(core::Id map) const;  // the newer of synced_ and published_; mutex_ held
   void releaseHeld(core::Id map);           // applies the held local maps the epoch has reached

@@ -32,6 +32,17 @@ struct DistributionSettings {
   // from the node that held them. Up to this long, its keyframes of a map it does not hold yet
   // wait for that map: mapped from nothing, they would start a second copy of it.
   int handover_wait_ms = 10000;
+  // A tracking node in real time releases its peers (Control::Release: they leave) and runs
+  // the whole system alone once release_slow_acks keyframe acknowledgements in a row took
+  // longer than release_slow_gateway_ms each, none came for release_slow_acks times that long,
+  // or tracking was lost with a keyframe waiting longer than that (distribution/gateway_watch).
+  // 0 in either: never. Loopback acknowledgements take 25-85 ms; over a 2 Mbit/s link they
+  // took 2-50 s (docs/BENCHMARKS.md, session 41).
+  int release_slow_gateway_ms = 1000;
+  int release_slow_acks = 3;
+  // How long a dead peer can still look present: the DDS lease (2 s) and its handling. A
+  // gateway killed mid-run starves tracking as a slow one does until it is seen to leave.
+  int dead_peer_ms = 2500;
 };
 
 }  // namespace hiveslam::distribution

@@ -116,12 +116,16 @@ void applyDistributionSettings(const std::filesystem::path& file, distribution::
       {"global_batch_gap_ms", set(s.global_batch_gap_ms)},
       {"remote_mapping_wait_ms", set(s.remote_mapping_wait_ms)},
       {"handover_wait_ms", set(s.handover_wait_ms)},
+      {"release_slow_gateway_ms", set(s.release_slow_gateway_ms)},
+      {"release_slow_acks", set(s.release_slow_acks)},
+      {"dead_peer_ms", set(s.dead_peer_ms)},
   };
   apply(file, section, keys, "distribution.");
   if (s.local_first_batch < 1 || s.local_max_batch < s.local_first_batch || s.global_batch < 1 ||
       s.local_batch_gap_ms < 0 || s.global_batch_gap_ms < 0 || s.local_window < 1 || s.min_point_move < 0 ||
       s.point_descriptor_bits < 0 || s.point_normal_deg < 0 || s.point_range_ratio < 0 ||
-      s.remote_mapping_wait_ms < 0 || s.handover_wait_ms < 0)
+      s.remote_mapping_wait_ms < 0 || s.handover_wait_ms < 0 || s.release_slow_gateway_ms < 0 ||
+      s.release_slow_acks < 0 || s.dead_peer_ms < 0)
     throw InputError(file.string() + ": distribution settings out of range (batches and local_window >= 1, first <= max, times, "
                      "min_point_move and point tolerances >= 0)");
 }

@@ -252,5 +252,87 @@ TEST(KeyframeAcks, TheReportSummarizesTheRoundTripsByRank) {
   EXPECT_DOUBLE_EQ(DistributedNode::ackSummary({7.0})["p95"].get<double>(), 7.0);
 }
 
+// Slow: acknowledgements in a row each later than the limit, or none at all for as many
+// times the limit (and longer than a dead gateway's lease). One prompt answer clears the count.
+TEST(SlowLink, AGatewayIsTooSlowAfterLateAcknowledgementsInARowOrALongSilence) {
+  using namespace std::chrono_literals;
+  const GatewayWatch::Clock::time_point t0{};
+  GatewayWatch w(1s, 3, 2500ms);
+  EXPECT_FALSE(w.tooSlow(t0 + 100s)) << "nothing sent, nothing waits";
+  w.sent(t0);
+  w.answered(4s);
+  w.answered(5s);
+  w.answered(50ms);  // a prompt one: the run is broken
+  w.answered(4s);
+  w.answered(4s);
+  EXPECT_FALSE(w.tooSlow(t0 + 20s));
+  w.answered(1500ms);
+  EXPECT_TRUE(w.tooSlow(t0 + 20s)) << "acknowledgements prove the gateway alive: no lease to wait out";
+  EXPECT_EQ(w.slowInARow(), 3);
+
+  GatewayWatch quiet(1s, 3, 2500ms);
+  quiet.sent(t0);
+  quiet.sent(t0 + 2s);  // still waiting since the first
+  EXPECT_FALSE(quiet.tooSlow(t0 + 3s));
+  EXPECT_TRUE(quiet.tooSlow(t0 + 3100ms));
+  quiet.answered(3100ms);  // one late answer ends the silence, and is one late answer
+  EXPECT_FALSE(quiet.tooSlow(t0 + 20s));
+  GatewayWatch leased(1s, 3, 5s);
+  leased.sent(t0);
+  EXPECT_FALSE(leased.tooSlow(t0 + 4s)) << "a dead gateway may still look present";
+  EXPECT_TRUE(leased.tooSlow(t0 + 5100ms));
+  // At a loss: a keyframe unanswered for longer than the limit and the lease, and recent.
+  EXPECT_FALSE(quiet.starved(t0 + 10s, t0 + 8s)) << "within a dead gateway's lease";
+  EXPECT_TRUE(quiet.starved(t0 + 10s, t0 + 7s));
+  EXPECT_FALSE(quiet.starved(t0 + 30s, t0)) << "dropped long ago (its map merged), not a slow link";
+  GatewayWatch off(0s, 3, 2500ms);
+  off.sent(t0);
+  EXPECT_FALSE(off.tooSlow(t0 + 100s)) << "0: never";
+  EXPECT_FALSE(off.starved(t0 + 3s, t0));
+}
+
+// TR gives up offloading: every peer gets a Release, and TR runs the whole system alone. The
+// released nodes' announcements, until they leave, change nothing; a restarted one is a
+// newcomer again.
+TEST(SlowLink, ATrackingNodeReleasesItsPeersAndRunsAlone) {
+  TrackingNode tr;
+  tr.transport.lm_reads = true;
+  tr.transport.peer(peerInfo(3, Task::LoopClosing, {1, 2}), true);
+  tr.transport.peer(peerInfo(2, Task::Mapping, {1, 3}), true);
+  ASSERT_TRUE(tr.node.plan().keyframes_to_lm);
+  tr.node.releasePeers("a test");
+  EXPECT_TRUE(tr.transport.published(Topic::TrKeyframes, Control::Release)) << "LM was not told";
+  EXPECT_TRUE(tr.transport.published(Topic::LmMap, Control::Release)) << "LC was not told";
+  const auto alone = [&] {
+    const Plan p = tr.node.plan();
+    return p.mapping && p.loop_closing && !p.keyframes_to_lm && !p.keyframes_to_lc && tr.node.presentTasks() == 0;
+  };
+  EXPECT_TRUE(alone());
+  tr.transport.peer(peerInfo(2, Task::Mapping, {1, 3}), true);  // announced again before leaving
+  EXPECT_TRUE(alone()) << "a released node came back without restarting";
+  tr.transport.peer(peerInfo(2, Task::Mapping, {1, 3}), false);
+  tr.transport.peer(peerInfo(3, Task::LoopClosing, {1, 2}), false);
+  EXPECT_TRUE(alone());
+  PeerInfo restarted = peerInfo(2, Task::Mapping, {1});
+  ++restarted.incarnation;
+  tr.transport.peer(restarted, true);
+  EXPECT_TRUE(tr.node.plan().keyframes_to_lm) << "a restarted mapping node is a newcomer";
+  tr.transport.peer(restarted, false);
+  auto finished = std::async(std::launch::async, [&] { return tr.node.finishRun(std::chrono::minutes(10)); });
+  ASSERT_EQ(finished.wait_for(std::chrono::minutes(1)), std::future_status::ready) << "alone, TR waits for nobody";
+  EXPECT_TRUE(finished.get());
+}
+
+// A released node's run is over: it leaves, its map not the run's.
+TEST(SlowLink, AReleasedNodeEndsItsRun) {
+  TrackingNode lc(Task::LoopClosing);
+  lc.transport.peer(peerInfo(1, Task::Tracking, {3}), true);
+  EXPECT_FALSE(lc.node.waitUntilDone(std::chrono::milliseconds(100)));
+  lc.transport.deliver(Topic::LmMap, controlPacket(1, Control::Release));
+  EXPECT_TRUE(lc.node.waitUntilDone(std::chrono::minutes(1)));
+  EXPECT_TRUE(lc.node.released());
+  EXPECT_FALSE(lc.node.completed());
+}
+
 }  // namespace
 }  // namespace hiveslam::distribution

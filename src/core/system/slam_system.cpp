@@ -238,6 +238,8 @@ const FrameRecord& SlamSystem::process(const cv::Mat& gray, double timestamp) {
       if (hosting_loop_closing_) closer_.process(tracker_.map(), out.new_keyframe);
     }
   }
+  // Lost: this frame failed where the last one tracked.
+  if (events_ && !r.tracked && !records_.empty() && records_.back().tracked) events_->trackingLost();
   records_.push_back(std::move(r));
   return records_.back();
 }

@@ -48,6 +48,7 @@ class SlamSystem {
   ~SlamSystem();
   SlamSystem(const SlamSystem&) = delete;
   SlamSystem& operator=(const SlamSystem&) = delete;
+  Mode mode() const { return mode_; }
 
   // Adds saved maps (io/atlas_file) before the first frame: tracking starts by relocalizing in
   // the largest. With localization_only, no keyframe or map is made: the maps stay as loaded.

@@ -14,6 +14,8 @@ class SystemEvents {
   virtual ~SystemEvents() = default;
   // Tracking initialized a new map (tracking thread).
   virtual void mapCreated(const std::shared_ptr<Map>&) {}
+  // Tracking failed on a frame after tracking the one before (tracking thread).
+  virtual void trackingLost() {}
   // Tracking made a keyframe that local mapping will process elsewhere; it is already in the
   // map, linked to the points tracking matched (tracking thread).
   virtual void keyframeCreated(const std::shared_ptr<Map>&, const std::shared_ptr<KeyFrame>&) {}

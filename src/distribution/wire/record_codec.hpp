@@ -17,6 +17,8 @@ enum class Control : uint8_t {
   // A node holds keyframes of a map it never got (the packet that started the map was lost):
   // the node that sends it keyframes answers with a snapshot of the map (the packet's `map`).
   SendMap = 3,        // LC -> LM on LC's map topic, LM -> TR on LM's
+  // TR -> every peer: its link is too slow to offload to them; they leave, and TR runs alone.
+  Release = 4,
 };
 // Raised with every change of the encoding, so that a node of another build drops what it
 // cannot read with a warning instead of misreading it. 2: map records carry `update`.
