@@ -124,7 +124,7 @@ void addNodeCommand(CLI::App& app) {
   cmd->add_option("--times", o->times, "TR: times file for image folders and videos");
   cmd->add_flag("--realtime", o->realtime, "TR: feed frames at their timestamps");
   cmd->add_flag("--no-loop-closing", o->no_loop_closing, "Switch loop closing off");
-  cmd->add_option("--atlas-out", o->atlas_out, "Save the node's maps (its S_full) to an atlas file after the run");
+  cmd->add_option("--atlas-out", o->atlas_out, "Save the node's maps to an atlas file after the run (the same on every node after the end-of-run exchange)");
   cmd->callback([o]() {
     communication::Task task;
     if (!communication::parseTask(o->task, task)) throw InputError("unknown task '" + o->task + "' (tr, lm or lc)");

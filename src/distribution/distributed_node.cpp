@@ -113,12 +113,7 @@ DistributedNode::DistributedNode(core::SlamSystem& slam, communication::Transpor
     return departed_.count(node) > 0;
   });
   slam_.setEvents(this);
-  slam_.setRemoteMapping(
-      [this] {
-        watchGateway();
-        return remoteIdle();
-      },
-      [this] { remoteWait(); });
+  slam_.setRemoteMapping([this] { return remoteIdle(); }, [this] { remoteWait(); });
 }
 
 DistributedNode::~DistributedNode() {
@@ -190,10 +185,12 @@ void DistributedNode::onPeer(const PeerInfo& peer, bool present) {
     // A node released here is gone for this node already: its announcements until the Release
     // reaches it change nothing, and its leaving was counted at the release. Restarted (a new
     // incarnation), it is a newcomer like any other.
-    if (present ? released_.count({peer.node, peer.incarnation}) > 0
-                : std::erase_if(released_, [&](const auto& r) { return r.first == peer.node; }) > 0 &&
-                      !peers_.count(peer.node))
+    if (present) {
+      if (released_.count({peer.node, peer.incarnation})) return;
+    } else if (std::erase_if(released_, [&](const auto& r) { return r.first == peer.node; }) > 0 &&
+               !peers_.count(peer.node)) {
       return;
+    }
     leaving = stopping_;
     if (present) {
       auto it = peers_.find(peer.node);
@@ -717,27 +714,24 @@ bool DistributedNode::released() const {
   return released_by_;
 }
 
-void DistributedNode::watchGateway() {
+void DistributedNode::watchGateway(std::chrono::steady_clock::time_point now) {
   // Only in real time does tracking starve: offline, it waits for the gateway instead.
   if (slam_.mode() != core::SlamSystem::Mode::Realtime) return;
-  std::lock_guard lock(mutex_);
   if (stopping_ || releaser_.joinable() || !plan_.keyframes_to_lm || handover_pending_) return;
-  const auto now = std::chrono::steady_clock::now();
-  const int slow_ms = options_.settings.release_slow_gateway_ms;
-  std::string why;
+  const int slow_ms = options_.settings.release_slow_gateway_ms, slow_acks = options_.settings.release_slow_acks;
   const auto starved = [&](const auto& waiting) {
     return std::any_of(waiting.begin(), waiting.end(), [&](const auto& k) { return watch_.starved(now, k.second); });
   };
+  std::string why;
   if (lost_waiting_ && (starved(outstanding_) || starved(unanswered_)))
     why = fmt::format("tracking lost with a keyframe unacknowledged for over {} ms",
                       std::max(slow_ms, options_.settings.dead_peer_ms));
   else if (!watch_.tooSlow(now))
     return;
-  else if (watch_.slowInARow() > 0)
+  else if (watch_.slowInARow() >= slow_acks)
     why = fmt::format("{} keyframe acknowledgements in a row took over {} ms", watch_.slowInARow(), slow_ms);
   else
-    why = fmt::format("no keyframe acknowledged for {} ms",
-                      std::max(slow_ms * options_.settings.release_slow_acks, options_.settings.dead_peer_ms));
+    why = fmt::format("no keyframe acknowledged for {} ms", std::max(slow_ms * slow_acks, options_.settings.dead_peer_ms));
   releaser_ = std::thread([this, why] { releasePeers(why); });
 }
 
@@ -786,11 +780,12 @@ void DistributedNode::stop() {
   handler_->finish();
 }
 
-bool DistributedNode::remoteIdle() const {
+bool DistributedNode::remoteIdle() {
   std::lock_guard lock(mutex_);
   // An acknowledgement that never came (the keyframe was dropped at the gateway: its map was
   // merged meanwhile, or the gateway changed) must not hold keyframes back for good.
-  const auto lost = std::chrono::steady_clock::now() - std::chrono::milliseconds(options_.settings.remote_mapping_wait_ms);
+  const auto now = std::chrono::steady_clock::now();
+  const auto lost = now - std::chrono::milliseconds(options_.settings.remote_mapping_wait_ms);
   for (auto it = outstanding_.begin(); it != outstanding_.end();)
     if (it->second < lost) {
       unanswered_.insert(*it);
@@ -800,6 +795,7 @@ bool DistributedNode::remoteIdle() const {
     }
   constexpr size_t kUnansweredKept = 64;  // bounded: an LM that lives on never answers them
   while (unanswered_.size() > kUnansweredKept) unanswered_.erase(unanswered_.begin());
+  watchGateway(now);
   return outstanding_.empty();
 }
 

@@ -16,9 +16,9 @@
 // after TR took mapping back). Its keyframes of those maps wait for the snapshot.
 //
 // Slow link: a tracking node whose gateway acknowledges its keyframes too late (GatewayWatch)
-// releases its peers (Control::Release) and runs alone from then on,
-// as the standalone system. It ignores them until they leave; a released node leaves the
-// network when the Release reaches it, and ends its run "released".
+// releases its peers (Control::Release) and runs alone from then on, as the standalone system.
+// It ignores them until they leave; a released node leaves the network when the Release
+// reaches it, and ends its run "released".
 //
 // Lost map: a node that gets keyframes of a map it does not hold, with no snapshot coming (the
 // packet that started the map was lost), asks the node that sends it keyframes for the map
@@ -128,11 +128,13 @@ class DistributedNode final : public core::SystemEvents {
   void awaitMap(core::Id id, uint8_t target);
   // Control::SendMap: a snapshot of the map for the node that asked, if this node feeds it.
   void answerMapRequest(const communication::Message& m, communication::Topic topic);
-  bool remoteIdle() const;
+  // Tracking thread, each frame while mapping is remote: whether the gateway has acknowledged
+  // every keyframe (those it never will no longer count), and watchGateway().
+  bool remoteIdle();
   void remoteWait() const;
-  // Tracking thread, each frame while mapping is remote: starts releasePeers() on its own
-  // thread once the gateway is too slow (GatewayWatch).
-  void watchGateway();
+  // With mutex_ held: starts releasePeers() on its own thread once the gateway is too slow
+  // (GatewayWatch).
+  void watchGateway(std::chrono::steady_clock::time_point now);
   communication::PeerInfo self() const;
 
   core::SlamSystem& slam_;
@@ -154,10 +156,10 @@ class DistributedNode final : public core::SystemEvents {
   std::map<core::Id, uint64_t> synced_;     // last global epoch applied, per map
   std::map<core::Id, uint64_t> published_;  // LC: last global epoch published, per map
   // TR: keyframes sent, not yet acknowledged as mapped (MapRecord::mapped), with when they went.
-  mutable std::map<core::Id, std::chrono::steady_clock::time_point> outstanding_;
+  std::map<core::Id, std::chrono::steady_clock::time_point> outstanding_;
   // TR: those no longer waited for (remote_mapping_wait_ms passed). Mapped here if this node
   // takes mapping back: the mapping node died before it mapped them.
-  mutable std::map<core::Id, std::chrono::steady_clock::time_point> unanswered_;
+  std::map<core::Id, std::chrono::steady_clock::time_point> unanswered_;
   std::vector<MapRecord> held_;             // local maps ahead of synced_, in arrival order
   bool done_ = false, lc_done_ = false;
   bool lc_answered_ = false;  // LC: its Done went to the gateway that asked last

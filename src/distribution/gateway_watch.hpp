@@ -6,8 +6,9 @@
 // link gives: `slow_acks` acknowledgements in a row each later than `slow`; no answer at all
 // for `slow_acks` times `slow` while keyframes wait; or tracking lost while a keyframe has
 // waited longer than `slow` (over 2 Mbit/s the first map was lost 1.3 s after it began, before
-// any acknowledgement). The last two wait out a dead gateway's lease. A keyframe the gateway dropped (its map merged meanwhile) never
-// answers: it counts for nothing once a later one does, and at a loss only while it is recent.
+// any acknowledgement). The last two wait out a dead gateway's lease. A keyframe the gateway
+// dropped (its map merged meanwhile) never answers: it counts for nothing once a later one
+// does, and at a loss only while it is recent.
 #include <algorithm>
 #include <chrono>
 #include <optional>
