@@ -178,75 +178,37 @@ Plan DistributedNode::plan() const {
 }
 
 void DistributedNode::onPeer(const PeerInfo& peer, bool present) {
+  if (!present) {
+    onLeaving(peer);
+    return;
+  }
   bool newcomer = false, restarted = false, leaving = false;
   const Plan before = plan();
   {
     std::lock_guard lock(mutex_);
     // A node released here is gone for this node already: its announcements until the Release
-    // reaches it change nothing, and its leaving was counted at the release. Restarted (a new
-    // incarnation), it is a newcomer like any other.
-    if (present) {
-      if (released_.count({peer.node, peer.incarnation})) return;
-    } else if (std::erase_if(released_, [&](const auto& r) { return r.first == peer.node; }) > 0 &&
-               !peers_.count(peer.node)) {
-      return;
-    }
+    // reaches it change nothing. Restarted (a new incarnation), it is a newcomer like any other.
+    if (released_.count({peer.node, peer.incarnation})) return;
     leaving = stopping_;
-    if (present) {
-      auto it = peers_.find(peer.node);
-      newcomer = it == peers_.end() || it->second.incarnation != peer.incarnation;
-      restarted = it != peers_.end() && newcomer;
-      peers_[peer.node] = peer;
-      had_mapping_peer_ = had_mapping_peer_ || peer.task == Task::Mapping;
-    } else {
-      peers_.erase(peer.node);
-    }
+    auto it = peers_.find(peer.node);
+    newcomer = it == peers_.end() || it->second.incarnation != peer.incarnation;
+    restarted = it != peers_.end() && newcomer;
+    peers_[peer.node] = peer;
+    had_mapping_peer_ = had_mapping_peer_ || peer.task == Task::Mapping;
   }
   {
     std::lock_guard lock(departed_mutex_);
-    if (present)
-      departed_.erase(peer.node);
-    else
-      departed_.insert(peer.node);
+    departed_.erase(peer.node);
   }
-  if (newcomer)
-    gate_.joined(peer.node, peer.task);
-  else if (!present)
-    gate_.left(peer.node);
+  if (newcomer) gate_.joined(peer.node, peer.task);
   spdlog::info("node {}: peer {} ({}) {}", options_.id, peer.name, communication::taskName(peer.task),
-               present ? (newcomer ? "joined" : "changed") : "left");
-  // A global map it was sending when it died would otherwise wait here, half collected, until
-  // its next batch: it is never completed. A node that left is judged once the packets it
-  // sent before leaving are handled: dropped at the notice, the batches still queued here of
-  // its last snapshot started a collection never completed (LC ended 71 points short, session
-  // 39). A restarted node's old packets are all in; its new ones must not be dropped.
-  const auto drop = [this, node = peer.node, name = peer.name] {
-    if (const size_t dropped = observer_.dropPendingGlobals(node))
-      spdlog::info("node {}: {} batches of an unfinished global map from {} dropped", options_.id, dropped, name);
-  };
-  if (restarted) {
-    drop();
-  } else if (!present) {
-    {
-      std::lock_guard lock(mutex_);
-      ++departures_;
-    }
-    // LC whose mapping node left: TR maps again, and is its gateway now.
-    const bool gateway_left = options_.task == Task::LoopClosing && peer.task == Task::Mapping;
-    handler_->afterIncoming([this, drop, gateway_left] {
-      drop();
-      if (gateway_left) resendGlobalsToTracking();
-      {
-        std::lock_guard lock(mutex_);
-        ++departures_handled_;
-      }
-      changed_.notify_all();
-    });
-  }
+               newcomer ? "joined" : "changed");
+  // A restarted node's old packets are all in; its new ones must not be dropped.
+  if (restarted) dropPendingGlobals(peer);
   if (leaving) return;  // no task is taken over or handed on while the transport goes down
   applyPlan();
   // The peers it sees changed: they learn it from the next announcement (see mutualTasks()).
-  if (newcomer || !present) transport_.announce(self());
+  if (newcomer) transport_.announce(self());
   // A node that joins late gets the maps so far from the gateway; a mapping node that joins
   // (or returns) gets them from the node that mapped until now, which gives mapping up to it.
   const Plan after = plan();
@@ -257,11 +219,69 @@ void DistributedNode::onPeer(const PeerInfo& peer, bool present) {
     handover_pending_ = true;
   }
   if (newcomer && (after.local_maps || (before.mapping && !after.mapping))) sendMapsTo(peer);
+}
+
+void DistributedNode::dropPendingGlobals(const PeerInfo& peer) {
+  // A global map it was sending when it died would otherwise wait here, half collected, until
+  // its next batch: it is never completed.
+  if (const size_t dropped = observer_.dropPendingGlobals(peer.node))
+    spdlog::info("node {}: {} batches of an unfinished global map from {} dropped", options_.id, dropped, peer.name);
+}
+
+void DistributedNode::onLeaving(const PeerInfo& peer) {
+  {
+    std::lock_guard lock(mutex_);
+    // Its leaving was counted at the release.
+    if (std::erase_if(released_, [&](const auto& r) { return r.first == peer.node; }) > 0 && !peers_.count(peer.node))
+      return;
+    ++departures_;
+  }
+  {
+    std::lock_guard lock(departed_mutex_);
+    departed_.insert(peer.node);
+  }
+  gate_.left(peer.node);  // keyframes no longer wait for its readers
+  spdlog::info("node {}: peer {} ({}) left", options_.id, peer.name, communication::taskName(peer.task));
+  // The rest waits until the packets it sent before leaving are handled. Dropped at the
+  // notice, the batches still queued here of its last snapshot started a collection never
+  // completed (LC ended 71 points short, session 39). And a gateway that leaves at the end of
+  // a run has sent its Done before its leaving notice, which can overtake it (the notice comes
+  // on its own topic and is handled at once): taken as a death, TR took mapping back and LC
+  // and TR sent each other their whole maps, the newcomer's reader wait holding TR 10 s past
+  // the end (2 of 5 bench runs). The peer stays a peer until then: any re-plan meanwhile (a
+  // peer's changed announcement) keeps the plan it had.
+  handler_->afterIncoming([this, peer] {
+    dropPendingGlobals(peer);
+    departed(peer);
+    {
+      std::lock_guard lock(mutex_);
+      ++departures_handled_;
+    }
+    changed_.notify_all();
+  });
+}
+
+void DistributedNode::departed(const PeerInfo& peer) {
+  const Plan before = plan();
+  {
+    std::lock_guard lock(mutex_);
+    auto it = peers_.find(peer.node);
+    // Back meanwhile as a new incarnation: that one is a peer.
+    if (it == peers_.end() || it->second.incarnation != peer.incarnation) return;
+    peers_.erase(it);
+    // Stopping, or the run is over here (the gateway's Done is in): nothing is taken over.
+    if (stopping_ || done_) return;
+  }
+  applyPlan();
+  transport_.announce(self());
+  // LC whose mapping node left: TR maps again, and is its gateway now.
+  if (options_.task == Task::LoopClosing && peer.task == Task::Mapping) resendGlobalsToTracking();
   // TR, the gateway now that its LM left, and an LC: the keyframes LM had mapped but not yet
   // sent on to LC never reach it (LC's S_full got their records from TR's last snapshot, its
   // SLAM map never their features: a keyframe short of TR, session 40). The newcomer's snapshot
   // brings the features of those it lacks.
-  if (!present && before.keyframes_to_lm && after.keyframes_to_lc)
+  const Plan after = plan();
+  if (before.keyframes_to_lm && after.keyframes_to_lc)
     for (const auto& lc : peersWith(Task::LoopClosing)) sendMapsTo(lc);
 }
 
@@ -347,6 +367,11 @@ void DistributedNode::awaitMap(core::Id id, uint8_t target) {
 }
 
 void DistributedNode::applyPlan() {
+  // Called from the transport's peer thread, the map handler's (a departure) and the releaser:
+  // one at a time, or two could change the hosting and the subscriptions in opposite orders.
+  // Not held while announcing: the in-process transport calls the peers' handlers from there,
+  // and theirs may come back here.
+  std::unique_lock apply(apply_mutex_);
   std::vector<Topic> add, remove;
   Plan p;
   std::map<core::Id, std::chrono::steady_clock::time_point> orphans;  // by id: mapped in order
@@ -398,6 +423,7 @@ void DistributedNode::applyPlan() {
     else
       transport_.subscribe(t, [this, t](Message&& m) { handler_->incoming(std::move(m), t); });
   }
+  apply.unlock();
   transport_.announce(self());
   changed_.notify_all();
 }

@@ -103,6 +103,12 @@ class DistributedNode final : public core::SystemEvents {
 
  private:
   void onPeer(const communication::PeerInfo& peer, bool present);
+  // A peer's leaving notice (transport thread): what must not wait; departed() follows on the
+  // map handler's thread, once the packets the peer sent before it are handled.
+  void onLeaving(const communication::PeerInfo& peer);
+  // The peer leaves peers_ and the tasks are re-planned, unless the run is over here.
+  void departed(const communication::PeerInfo& peer);
+  void dropPendingGlobals(const communication::PeerInfo& peer);
   void applyPlan();
   void onGlobal(std::vector<MapRecord>&& batches, communication::Topic topic);
   void onControl(const communication::Message& m, communication::Topic topic);
@@ -148,6 +154,7 @@ class DistributedNode final : public core::SystemEvents {
   std::unique_ptr<KeyframeSubscriber> subscriber_;
   std::unique_ptr<MapHandler> handler_;
 
+  std::mutex apply_mutex_;  // one applyPlan() at a time; taken before mutex_
   mutable std::mutex mutex_;  // guards everything below
   mutable std::condition_variable changed_;
   std::map<uint16_t, communication::PeerInfo> peers_;
