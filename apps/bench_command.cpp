@@ -30,11 +30,18 @@ nlohmann::json runBench(const BenchOptions& o) {
   const std::filesystem::path out(o.out);
   for (const auto& seq : o.sequences) {
     const std::string name = std::filesystem::path(seq).filename().string();
-    for (int nodes : o.nodes) {
-      BenchRow row;
-      row.sequence = name;
-      row.nodes = nodes;
-      for (int r = 0; r < o.repeats; ++r) {
+    std::vector<BenchRow> rows(o.nodes.size());
+    for (size_t i = 0; i < o.nodes.size(); ++i) {
+      rows[i].sequence = name;
+      rows[i].nodes = o.nodes[i];
+    }
+    // The configurations take turns, run by run: this machine's speed drifts over minutes (a
+    // bench's tracking medians moved 20% between its 1-node and its 3-node runs, session 42),
+    // and the CPU rule compares the two.
+    for (int r = 0; r < o.repeats; ++r) {
+      for (size_t i = 0; i < o.nodes.size(); ++i) {
+        const int nodes = o.nodes[i];
+        BenchRow& row = rows[i];
         ClusterOptions c;
         c.nodes = nodes;
         c.dataset = seq;
@@ -61,8 +68,8 @@ nlohmann::json runBench(const BenchOptions& o) {
                             : result.reports.count("lm") ? result.reports.at("lm").value("loops", 0)
                                                          : tr.value("loops", 0));
       }
-      all.push_back(row.toJson());
     }
+    for (const auto& row : rows) all.push_back(row.toJson());
   }
   std::filesystem::create_directories(out);
   std::ofstream(out / "bench.json") << all.dump(2) << "\n";
