@@ -443,8 +443,9 @@ void DistributedNode::keyframeCreated(const std::shared_ptr<core::Map>& map, con
   if (!plan().keyframes_to_lm) return;
   {
     std::lock_guard lock(mutex_);
-    outstanding_.emplace(kf->id, std::chrono::steady_clock::now());
-    watch_.sent(std::chrono::steady_clock::now());
+    const auto now = std::chrono::steady_clock::now();
+    outstanding_.emplace(kf->id, now);
+    watch_.sent(now);
   }
   publisher_->push({map, kf, Topic::TrKeyframes, kTargetLm});
 }

@@ -31,6 +31,18 @@ using communication::Task;
 using communication::taskBit;
 using communication::Topic;
 
+// Waits until `pred` holds: the node answers on its own threads (a departure, say, is handled
+// on its map handler's thread once the packets the peer sent before its notice are).
+template <class Pred>
+bool eventually(Pred pred, std::chrono::seconds within = std::chrono::seconds(30)) {
+  const auto until = std::chrono::steady_clock::now() + within;
+  while (!pred()) {
+    if (std::chrono::steady_clock::now() > until) return false;
+    std::this_thread::sleep_for(std::chrono::milliseconds(2));
+  }
+  return true;
+}
+
 // A transport whose peer events the test makes, and whose mapping peer's keyframe reader
 // matches when the test says so. It keeps the node's last announcement.
 class ScriptedTransport final : public communication::Transport {
@@ -79,15 +91,12 @@ class ScriptedTransport final : public communication::Transport {
   }
   // Waits until the node has published `count` control packets `c` on `topic`.
   bool published(Topic topic, Control c, int count = 1, std::chrono::seconds within = std::chrono::seconds(30)) {
-    const auto until = std::chrono::steady_clock::now() + within;
-    while (std::chrono::steady_clock::now() < until) {
-      {
-        std::lock_guard lock(mutex_);
-        if (std::count(controls_.begin(), controls_.end(), std::pair{topic, c}) >= count) return true;
-      }
-      std::this_thread::sleep_for(std::chrono::milliseconds(5));
-    }
-    return false;
+    return eventually(
+        [&] {
+          std::lock_guard lock(mutex_);
+          return std::count(controls_.begin(), controls_.end(), std::pair{topic, c}) >= count;
+        },
+        within);
   }
 
  private:
@@ -97,18 +106,6 @@ class ScriptedTransport final : public communication::Transport {
   PeerHandler on_peer_;
   std::array<Handler, communication::kTopicCount> handlers_;
 };
-
-// A departure is handled on the node's map handler thread, once the packets the peer sent
-// before its leaving notice are: the test waits for it.
-template <class Pred>
-bool eventually(Pred pred, std::chrono::seconds within = std::chrono::seconds(30)) {
-  const auto until = std::chrono::steady_clock::now() + within;
-  while (!pred()) {
-    if (std::chrono::steady_clock::now() > until) return false;
-    std::this_thread::sleep_for(std::chrono::milliseconds(2));
-  }
-  return true;
-}
 
 PeerInfo peerInfo(uint16_t node, Task task, std::vector<uint16_t> seen) {
   PeerInfo p;
@@ -139,6 +136,13 @@ struct TrackingNode {
   ScriptedTransport transport;
   DistributedNode node;
 };
+
+// TR with an LM that reads its keyframes and an LC, each having heard the other two.
+void offloadToLmAndLc(TrackingNode& tr) {
+  tr.transport.lm_reads = true;
+  tr.transport.peer(peerInfo(3, Task::LoopClosing, {1, 2}), true);
+  tr.transport.peer(peerInfo(2, Task::Mapping, {1, 3}), true);
+}
 
 TEST(MutualDiscovery, ATrackingNodeWaitsForPeersThatHaveHeardItAndAMappingPeerThatReadsItsKeyframes) {
   TrackingNode tr;
@@ -210,9 +214,7 @@ TEST(EndOfRun, ADoneSentBeforeTheGatewayLeftCountsThoughTheNoticeCameFirst) {
 // for its Done as the new gateway and ends with the exchange completed.
 TEST(EndOfRun, ATrackingNodeWhoseGatewayLeftFinishesTheRunWithTheLoopClosingNode) {
   TrackingNode tr;
-  tr.transport.lm_reads = true;
-  tr.transport.peer(peerInfo(3, Task::LoopClosing, {1, 2}), true);
-  tr.transport.peer(peerInfo(2, Task::Mapping, {1, 3}), true);
+  offloadToLmAndLc(tr);
   ASSERT_TRUE(tr.node.plan().keyframes_to_lm);
   auto finished = std::async(std::launch::async, [&] { return tr.node.finishRun(std::chrono::minutes(10)); });
   ASSERT_TRUE(tr.transport.published(Topic::TrKeyframes, Control::EndOfSequence));
@@ -312,9 +314,7 @@ TEST(SlowLink, AGatewayIsTooSlowAfterLateAcknowledgementsInARowOrALongSilence) {
 // newcomer again.
 TEST(SlowLink, ATrackingNodeReleasesItsPeersAndRunsAlone) {
   TrackingNode tr;
-  tr.transport.lm_reads = true;
-  tr.transport.peer(peerInfo(3, Task::LoopClosing, {1, 2}), true);
-  tr.transport.peer(peerInfo(2, Task::Mapping, {1, 3}), true);
+  offloadToLmAndLc(tr);
   ASSERT_TRUE(tr.node.plan().keyframes_to_lm);
   tr.node.releasePeers("a test");
   EXPECT_TRUE(tr.transport.published(Topic::TrKeyframes, Control::Release)) << "LM was not told";
