@@ -71,9 +71,7 @@ void serve(const NodeCommandOptions& o, communication::Task task) {
   report["end_of_run"] = !done ? "interrupted" : node.released() ? "released" : node.completed() ? "completed" : "incomplete";
   if (done && !node.completed() && !node.released())
     fmt::print(stderr, "warning: the gateway left before the end-of-run exchange completed; this node's map may lack its last snapshot\n");
-  report["mapping"] = {{"keyframes_processed", ms.keyframes_processed}, {"points_created", ms.points_created},
-                       {"keyframes_culled", ms.keyframes_culled}, {"local_bas", ms.local_bas},
-                       {"local_bas_discarded", ms.local_bas_discarded}, {"local_bas_cut_short", ms.local_bas_cut_short}};
+  report["mapping"] = mappingStatsJson(ms);  // points_culled too: LM's report lacked it
   report["loop_closing"] = settings.loop_closing;
   report["loops"] = ls.loops;
   report["merges"] = ls.merges;

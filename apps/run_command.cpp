@@ -28,6 +28,13 @@
 
 namespace hiveslam::apps {
 
+nlohmann::json mappingStatsJson(const core::MappingStats& ms) {
+  return {{"keyframes_processed", ms.keyframes_processed}, {"points_created", ms.points_created},
+          {"points_culled", ms.points_culled}, {"keyframes_culled", ms.keyframes_culled},
+          {"local_bas", ms.local_bas}, {"local_bas_discarded", ms.local_bas_discarded},
+          {"local_bas_cut_short", ms.local_bas_cut_short}};
+}
+
 nlohmann::json loopEventsJson(const core::LoopStats& stats) {
   nlohmann::json events = nlohmann::json::array();
   for (const auto& e : stats.events)
@@ -257,9 +264,7 @@ RunSummary runSlam(const RunOptions& o) {
                            {"mean", tracking_ms.empty() ? 0.0 : sum / tracking_ms.size()},
                            {"p95", percentile(tracking_ms, 0.95)}};
   const auto& ms = slam.mappingStats();
-  report["mapping"] = {{"keyframes_processed", ms.keyframes_processed}, {"points_created", ms.points_created},
-                       {"points_culled", ms.points_culled}, {"keyframes_culled", ms.keyframes_culled},
-                       {"local_bas", ms.local_bas}, {"local_bas_discarded", ms.local_bas_discarded}, {"local_bas_cut_short", ms.local_bas_cut_short}};
+  report["mapping"] = mappingStatsJson(ms);
   std::string ate_line = "no ground truth";
   if (truth && estimate.size() >= 3) {
     try {

@@ -4,6 +4,7 @@
 #include <nlohmann/json.hpp>
 
 #include "core/loop/loop_closer.hpp"
+#include "core/mapping/local_mapper.hpp"
 #include <string>
 #include <vector>
 
@@ -40,6 +41,8 @@ struct RunOptions {
 // Each loop closure and merge as a report entry: kind, timestamp of the keyframe that
 // recognized the place, matches, the Sim3's scale (the drift seen), timings.
 nlohmann::json loopEventsJson(const core::LoopStats& stats);
+// Local mapping's counts (keyframes processed and culled, points made and culled, local BAs).
+nlohmann::json mappingStatsJson(const core::MappingStats& stats);
 
 struct RunSummary {
   nlohmann::json report;  // what report.json holds

@@ -236,12 +236,19 @@ void MapHandler::loop() {
       // one is lost work, and where updates come faster than a whole map takes to send (global
       // BAs back to back on a large map: 14 batches 100 ms apart, a global BA every 1.2 s) none
       // ever arrived: 12 in a row at the end of a 3-node bigloop run (session 33).
+      const int gap = g.topic == Topic::LcMap ? settings_.lc_global_batch_gap_ms : settings_.global_batch_gap_ms;
       if (g.next < g.batches.size()) globals_.push_front(std::move(g));
-      next_global = Clock::now() + std::chrono::milliseconds(settings_.global_batch_gap_ms);
+      next_global = Clock::now() + std::chrono::milliseconds(gap);
       continue;
     }
-    if (local_pending && now >= next_local) {
-      auto it = std::find_if(outgoing_.begin(), outgoing_.end(), [](const auto& o) { return !o.second.dirty.empty() || !o.second.dirty_points.empty(); });
+    // An acknowledgement does not wait for the gap (DistributionSettings::local_batch_gap_ms).
+    const auto acknowledging = std::find_if(outgoing_.begin(), outgoing_.end(), [](const auto& o) {
+      return std::any_of(o.second.mapped.begin(), o.second.mapped.end(), [&](core::Id id) { return o.second.dirty.count(id) > 0; });
+    });
+    if (local_pending && (now >= next_local || acknowledging != outgoing_.end())) {
+      auto it = acknowledging != outgoing_.end()
+                    ? acknowledging
+                    : std::find_if(outgoing_.begin(), outgoing_.end(), [](const auto& o) { return !o.second.dirty.empty() || !o.second.dirty_points.empty(); });
       Outgoing& o = it->second;
       busy_ = true;
       // The batch's keyframes and points leave the dirty sets under the lock; capture is outside.
@@ -249,6 +256,9 @@ void MapHandler::loop() {
       batch.map = o.map;
       batch.topic = o.topic;
       const int n = std::min(settings_.local_first_batch * (o.batch + 1), settings_.local_max_batch);
+      // The acknowledged keyframes first, so that this batch carries the acknowledgements.
+      for (core::Id id : o.mapped)
+        if (o.dirty.erase(id)) batch.dirty.insert(id);
       while (!o.dirty.empty() && static_cast<int>(batch.dirty.size()) < n) {
         batch.dirty.insert(*o.dirty.begin());
         o.dirty.erase(o.dirty.begin());

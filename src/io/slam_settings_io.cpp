@@ -114,6 +114,7 @@ void applyDistributionSettings(const std::filesystem::path& file, distribution::
       {"point_range_ratio", set(s.point_range_ratio)},
       {"global_batch", set(s.global_batch)},
       {"global_batch_gap_ms", set(s.global_batch_gap_ms)},
+      {"lc_global_batch_gap_ms", set(s.lc_global_batch_gap_ms)},
       {"remote_mapping_wait_ms", set(s.remote_mapping_wait_ms)},
       {"handover_wait_ms", set(s.handover_wait_ms)},
       {"release_slow_gateway_ms", set(s.release_slow_gateway_ms)},
@@ -122,8 +123,8 @@ void applyDistributionSettings(const std::filesystem::path& file, distribution::
   };
   apply(file, section, keys, "distribution.");
   if (s.local_first_batch < 1 || s.local_max_batch < s.local_first_batch || s.global_batch < 1 ||
-      s.local_batch_gap_ms < 0 || s.global_batch_gap_ms < 0 || s.local_window < 1 || s.min_point_move < 0 ||
-      s.point_descriptor_bits < 0 || s.point_normal_deg < 0 || s.point_range_ratio < 0 ||
+      s.local_batch_gap_ms < 0 || s.global_batch_gap_ms < 0 || s.lc_global_batch_gap_ms < 0 || s.local_window < 1 ||
+      s.min_point_move < 0 || s.point_descriptor_bits < 0 || s.point_normal_deg < 0 || s.point_range_ratio < 0 ||
       s.remote_mapping_wait_ms < 0 || s.handover_wait_ms < 0 || s.release_slow_gateway_ms < 0 ||
       s.release_slow_acks < 0 || s.dead_peer_ms < 0)
     throw InputError(file.string() + ": distribution settings out of range (batches and local_window >= 1, first <= max, times, "

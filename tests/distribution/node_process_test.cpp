@@ -195,6 +195,15 @@ std::string nodeDigest(const fs::path& node) {
 // The event lines (peers, hand-overs, ignored or cut-short maps) of every node log in `out`,
 // without the progress lines, then each node's digest: what a failed run's cause is read from
 // in CI, where the test's folder is gone afterwards.
+// Runs the bash command line `run` (no single quotes in it) and returns std::system's status.
+// Past `seconds` it is killed (exit status 124), once every hiveslam process under it has left
+// each thread's stack in out/stacks.log, which nodeEvents shows: a node that hangs once in a
+// hundred runs (TR after releasing its peers, once in session 43) says where.
+int runWithin(int seconds, const fs::path& out, const std::string& run) {
+  const std::string script = std::string(HIVESLAM_SOURCE_DIR) + "/tests/run_with_stacks.sh";
+  return std::system(("bash " + script + " " + std::to_string(seconds) + " " + out.string() + " '" + run + "'").c_str());
+}
+
 std::string nodeEvents(const fs::path& out) {
   std::string all;
   for (const auto& entry : fs::directory_iterator(out)) {
@@ -305,7 +314,7 @@ TEST(NodeProcesses, TrackingTakesMappingBackWhenTheMappingNodeDies) {
       " --expect lm,lc" + kRealtime + " --out " + (out / "tr").string() + " > " + (out / "tr.log").string() +
       " 2>&1 & tr=$!; " + untilFrame(72, out / "tr.log") + "kill -9 $lm; wait $tr; status=$?; " + awaitExit("lc") +
       "kill -0 $lc 2>/dev/null && { echo LC still waiting >> " + (out / "lc.log").string() + "; kill $lc; }; wait; exit $status";
-  const int status = std::system(("timeout 300 bash -c '" + run + "'").c_str());
+  const int status = runWithin(300, out.path(), run);
   ASSERT_EQ(status, 0) << std::ifstream(out / "tr.log").rdbuf();
   const auto tr = report(out / "tr" / "report.json");
   const auto hosted = tasks(tr);
@@ -354,7 +363,7 @@ RestartRun runWithARestart(const fs::path& out, const std::string& task, int dom
                           "; status=$?; " + awaitExit(others[0]) + awaitExit(others[1]) + "kill $" + others[0] + " $" +
                           others[1] + " 2>/dev/null; wait; exit $status";
   RestartRun r;
-  r.status = std::system(("timeout 300 bash -c '" + run + "'").c_str());
+  r.status = runWithin(300, out, run);
   if (r.status != 0) return r;
   auto of = [&](const std::string& t) { return report(out / (t == task ? t + "2" : t) / "report.json"); };
   r.tr = of("tr");
@@ -491,7 +500,7 @@ int runInNamespaces(const Namespaces& ns, const fs::path& out, int domain, const
                           node(3, "--task lc --out " + (out / "lc").string()) + " & " +
                           node(1, "--task tr " + sequence().string() + tr_options + " --expect lm,lc --out " + (out / "tr").string()) +
                           "; status=$?; wait; exit $status";
-  return std::system(("timeout 600 bash -c '" + run + "'").c_str());
+  return runWithin(600, out, run);
 }
 
 TEST(NodeProcesses, ThreeNodesInThreeNetworkNamespaces) {
@@ -601,7 +610,7 @@ TEST(NodeProcesses, AMappingNodeThatDiesAtTheEndLeavesTrackingToFinishWithLoopCl
       " --out " + (out / "tr").string() + " > " + (out / "tr.log").string() + " 2>&1 & tr=$!; " +
       "until ! kill -0 $tr || grep -q \"end of the sequence\" " + lm_log + "; do sleep 0.02; done; kill -9 $lm; " +
       "wait $tr; status=$?; " + awaitExit("lc") + "kill -0 $lc 2>/dev/null && { echo LC still waiting >> " + (out / "lc.log").string() + "; kill $lc; }; wait; exit $status";
-  const int status = std::system(("timeout 300 bash -c '" + run + "'").c_str());
+  const int status = runWithin(300, out.path(), run);
   ASSERT_EQ(status, 0) << nodeEvents(out.path());
   ASSERT_FALSE(fs::exists(out / "lm" / "report.json")) << "LM ended before it was killed";
   const auto tr = report(out / "tr" / "report.json"), lc = report(out / "lc" / "report.json");

@@ -5,7 +5,9 @@
 // On the same two-keyframe map: which keyframes a local map acknowledges as mapped.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <chrono>
+#include <optional>
 #include <thread>
 
 #include "communication/inproc/inproc_network.hpp"
@@ -15,6 +17,7 @@
 #include "distribution/map_handler.hpp"
 #include "distribution/packet.hpp"
 #include "distribution/state_integrator.hpp"
+#include "eventually.hpp"
 
 namespace hiveslam::distribution {
 namespace {
@@ -48,6 +51,38 @@ Eigen::Isometry3d moved(const Eigen::Isometry3d& T, const core::Sim3& S) {
   return (core::Sim3(Eigen::Quaterniond::Identity(), Eigen::Vector3d::Zero(), S.s) * core::Sim3(T) * S.inverse())
       .toPose();
 }
+
+// A map handler's sender and a receiver on an in-process network; the receiver decodes what
+// comes on the given map topics.
+struct MapTopics {
+  explicit MapTopics(std::initializer_list<communication::Topic> topics) {
+    receiver->start({}, [](const communication::PeerInfo&, bool) {});
+    for (auto topic : topics)
+      receiver->subscribe(topic, [this, topic](communication::Message&& m) {
+        std::lock_guard lock(mutex);
+        received.emplace_back(topic, decodeMap(unpack(m, PacketKind::Map)));
+      });
+    sender->start({}, [](const communication::PeerInfo&, bool) {});
+  }
+  ~MapTopics() {
+    sender->stop();
+    receiver->stop();
+  }
+  size_t count(std::optional<communication::Topic> topic = std::nullopt) {
+    std::lock_guard lock(mutex);
+    return static_cast<size_t>(std::count_if(received.begin(), received.end(), [&](const auto& r) { return !topic || r.first == *topic; }));
+  }
+  std::vector<MapRecord> records() {
+    std::lock_guard lock(mutex);
+    std::vector<MapRecord> out;
+    for (const auto& r : received) out.push_back(r.second);
+    return out;
+  }
+  communication::InProcNetwork network;
+  std::unique_ptr<communication::InProcTransport> sender = network.endpoint(), receiver = network.endpoint();
+  std::mutex mutex;
+  std::vector<std::pair<communication::Topic, MapRecord>> received;
+};
 
 class EpochLabels : public ::testing::Test {
  protected:
@@ -157,6 +192,12 @@ class EpochLabels : public ::testing::Test {
   static void expectPose(const core::KeyFrame& kf, const Eigen::Isometry3d& want) {
     EXPECT_LT((kf.T_cw.translation() - want.translation()).norm(), 1e-9);
     EXPECT_LT(Eigen::AngleAxisd(want.linear().transpose() * kf.T_cw.linear()).angle(), 1e-9);
+  }
+
+  std::shared_ptr<core::KeyFrame> keyframeHere(Id id) {
+    auto map = slam_.findMap(kMap);
+    std::lock_guard lock(map->mutex);
+    return map->keyframes.at(id);
   }
 
   std::optional<Eigen::Vector3d> pointHere(Id id) {
@@ -368,55 +409,33 @@ TEST_F(EpochLabels, ANewPointWithNoKeyframeToCarryItWaitsForAFreshRecord) {
 // yet: only the keyframe marked with `acknowledge` may count, or tracking runs ahead of
 // mapping and poses keyframes in a map without their predecessors' new points.
 TEST_F(EpochLabels, ALocalMapAcknowledgesOnlyTheKeyframeMappedNotItsNeighbours) {
-  communication::InProcNetwork network;
-  auto sender = network.endpoint(), receiver = network.endpoint();
-  std::mutex mutex;
-  std::vector<MapRecord> received;
-  receiver->start({}, [](const communication::PeerInfo&, bool) {});
-  receiver->subscribe(communication::Topic::LmMap, [&](communication::Message&& m) {
-    std::lock_guard lock(mutex);
-    received.push_back(decodeMap(unpack(m, PacketKind::Map)));
-  });
-  sender->start({}, [](const communication::PeerInfo&, bool) {});
+  MapTopics net{communication::Topic::LmMap};
   SentLedger ledger;
-  MapHandler handler(*sender, integrator_, observer_, ledger, DistributionSettings{}, 2, {});
+  MapHandler handler(*net.sender, integrator_, observer_, ledger, DistributionSettings{}, 2, {});
   const auto map = slam_.findMap(kMap);
-  std::shared_ptr<core::KeyFrame> first, second;
-  {
-    std::lock_guard lock(map->mutex);
-    first = map->keyframes.at(kFirst);
-    second = map->keyframes.at(kSecond);
-  }
+  const auto first = keyframeHere(kFirst), second = keyframeHere(kSecond);
   handler.markDirty(map, *first, communication::Topic::LmMap, -1, true);
   handler.finish();
   std::set<Id> carried, mapped;
-  {
-    std::lock_guard lock(mutex);
-    for (const auto& r : received) {
-      for (const auto& k : r.keyframes) carried.insert(k.id);
-      mapped.insert(r.mapped.begin(), r.mapped.end());
-    }
+  for (const auto& r : net.records()) {
+    for (const auto& k : r.keyframes) carried.insert(k.id);
+    mapped.insert(r.mapped.begin(), r.mapped.end());
   }
   EXPECT_EQ(carried, (std::set<Id>{kFirst, kSecond}));  // the neighbour rides along
   EXPECT_EQ(mapped, std::set<Id>{kFirst});
 
   // A keyframe local mapping culled before its batch left is still acknowledged.
-  MapHandler again(*sender, integrator_, observer_, ledger, DistributionSettings{}, 2, {});
+  MapHandler again(*net.sender, integrator_, observer_, ledger, DistributionSettings{}, 2, {});
   {
     std::lock_guard lock(map->mutex);
     second->bad = true;
   }
-  {
-    std::lock_guard lock(mutex);
-    received.clear();
-  }
+  const size_t before = net.count();
   again.markDirty(map, *second, communication::Topic::LmMap, 0, true);
   again.finish();
-  std::lock_guard lock(mutex);
-  ASSERT_FALSE(received.empty());
-  EXPECT_EQ(received.back().mapped, std::vector<Id>{kSecond});
-  sender->stop();
-  receiver->stop();
+  const auto records = net.records();
+  ASSERT_GT(records.size(), before);
+  EXPECT_EQ(records.back().mapped, std::vector<Id>{kSecond});
 }
 
 
@@ -425,40 +444,73 @@ TEST_F(EpochLabels, ALocalMapAcknowledgesOnlyTheKeyframeMappedNotItsNeighbours) 
 // must be finished: cut short for the next, none would ever arrive. Updates that are still
 // waiting meanwhile collapse into the newest.
 TEST_F(EpochLabels, GlobalMapsBegunAreFinishedWhenNewerOnesComeFasterThanTheyGoOut) {
-  communication::InProcNetwork network;
-  auto sender = network.endpoint(), receiver = network.endpoint();
-  std::mutex mutex;
-  std::map<uint64_t, std::set<uint32_t>> batches_of;  // epoch -> batches received
-  std::map<uint64_t, uint32_t> expected;
-  receiver->start({}, [](const communication::PeerInfo&, bool) {});
-  receiver->subscribe(communication::Topic::LcMap, [&](communication::Message&& m) {
-    const MapRecord r = decodeMap(unpack(m, PacketKind::Map));
-    std::lock_guard lock(mutex);
-    batches_of[r.epoch].insert(r.batch);
-    expected[r.epoch] = r.batches;
-  });
-  sender->start({}, [](const communication::PeerInfo&, bool) {});
+  MapTopics net{communication::Topic::LmMap};
   SentLedger ledger;
   DistributionSettings settings;
   settings.global_batch = 1;          // one keyframe a batch: two batches for the two keyframes
   settings.global_batch_gap_ms = 40;  // a whole map every 80 ms or so
-  MapHandler handler(*sender, integrator_, observer_, ledger, settings, 2, {});
+  MapHandler handler(*net.sender, integrator_, observer_, ledger, settings, 2, {});
   const auto map = slam_.findMap(kMap);
   constexpr uint64_t kUpdates = 12;
   for (uint64_t e = 1; e <= kUpdates; ++e) {
-    handler.sendGlobal(map, e, communication::Topic::LcMap, {});
+    handler.sendGlobal(map, e, communication::Topic::LmMap, {});
     std::this_thread::sleep_for(std::chrono::milliseconds(25));  // three updates per whole map
   }
   handler.finish();
-  std::lock_guard lock(mutex);
+  std::map<uint64_t, std::set<uint32_t>> batches_of;  // epoch -> batches received
+  std::map<uint64_t, uint32_t> expected;
+  for (const auto& r : net.records()) {
+    batches_of[r.epoch].insert(r.batch);
+    expected[r.epoch] = r.batches;
+  }
   ASSERT_FALSE(batches_of.empty());
   for (const auto& [epoch, got] : batches_of) EXPECT_EQ(got.size(), expected[epoch]) << "epoch " << epoch << " cut short";
   EXPECT_EQ(batches_of.rbegin()->first, kUpdates);  // the newest went out, whole
   // (How many in between depends on the machine's timing: about four here, the waiting ones
   // collapsed into newer ones.)
   EXPECT_EQ(handler.globalMapsSent(), static_cast<int>(batches_of.size()));
-  sender->stop();
-  receiver->stop();
+}
+
+// Tracking waits for its keyframe's acknowledgement, and the points that keyframe made are what
+// it tracks next: the batch that acknowledges it goes at once, though the batches local BA marks
+// go local_batch_gap_ms apart (here 3 s: the acknowledgement must come in half that).
+TEST_F(EpochLabels, AnAcknowledgementGoesAtOnceThoughTheLastBatchJustWent) {
+  MapTopics net{communication::Topic::LmMap};
+  SentLedger ledger;
+  DistributionSettings settings;
+  settings.local_batch_gap_ms = 3000;
+  MapHandler handler(*net.sender, integrator_, observer_, ledger, settings, 2, {});
+  const auto map = slam_.findMap(kMap);
+  handler.markDirty(map, *keyframeHere(kFirst), communication::Topic::LmMap);  // after a local BA: the window
+  ASSERT_TRUE(hiveslam::testing::eventually([&] { return net.count() == 1; }, std::chrono::seconds(10)));
+  handler.markDirty(map, *keyframeHere(kSecond), communication::Topic::LmMap, 0, /*acknowledge=*/true);
+  ASSERT_TRUE(hiveslam::testing::eventually([&] { return net.count() == 2; }, std::chrono::milliseconds(1500)))
+      << "the acknowledgement waited for the gap";
+  EXPECT_EQ(net.records().back().mapped, std::vector<Id>{kSecond});
+  // A window marked dirty without an acknowledgement still waits for the gap.
+  handler.markDirty(map, *keyframeHere(kFirst), communication::Topic::LmMap);
+  std::this_thread::sleep_for(std::chrono::milliseconds(300));
+  EXPECT_EQ(net.count(), 2u) << "a batch went before the gap was out";
+}
+
+// LC's map topic carries its global maps only, so nothing waits behind them there: their
+// batches go back to back (lc_global_batch_gap_ms 0), while LM's relay, which shares its
+// topic with the local maps tracking waits for, keeps the pacing.
+TEST_F(EpochLabels, LoopClosingsGlobalMapsGoBackToBackTheRelayIsPaced) {
+  using communication::Topic;
+  MapTopics net{Topic::LcMap, Topic::LmMap};
+  SentLedger ledger;
+  DistributionSettings settings;
+  settings.global_batch = 1;  // two batches for the two keyframes
+  settings.global_batch_gap_ms = 3000;
+  MapHandler handler(*net.sender, integrator_, observer_, ledger, settings, 3, {});
+  handler.sendGlobal(slam_.findMap(kMap), 1, Topic::LcMap, {});
+  EXPECT_TRUE(hiveslam::testing::eventually([&] { return net.count(Topic::LcMap) == 2; }, std::chrono::milliseconds(1500)))
+      << "LC's second batch waited for the gap";
+  handler.sendGlobal(slam_.findMap(kMap), 2, Topic::LmMap, {});
+  ASSERT_TRUE(hiveslam::testing::eventually([&] { return net.count(Topic::LmMap) == 1; }, std::chrono::seconds(10)));
+  std::this_thread::sleep_for(std::chrono::milliseconds(300));
+  EXPECT_EQ(net.count(Topic::LmMap), 1u) << "the relay's second batch did not wait for the gap";
 }
 
 // An authoritative snapshot (LM's relay) erases what its sender no longer has, judged by the

@@ -22,6 +22,7 @@
 #include "core/system/slam_system.hpp"
 #include "distribution/distributed_node.hpp"
 #include "distribution/packet.hpp"
+#include "eventually.hpp"
 
 namespace hiveslam::distribution {
 namespace {
@@ -31,17 +32,7 @@ using communication::Task;
 using communication::taskBit;
 using communication::Topic;
 
-// Waits until `pred` holds: the node answers on its own threads (a departure, say, is handled
-// on its map handler's thread once the packets the peer sent before its notice are).
-template <class Pred>
-bool eventually(Pred pred, std::chrono::seconds within = std::chrono::seconds(30)) {
-  const auto until = std::chrono::steady_clock::now() + within;
-  while (!pred()) {
-    if (std::chrono::steady_clock::now() > until) return false;
-    std::this_thread::sleep_for(std::chrono::milliseconds(2));
-  }
-  return true;
-}
+using hiveslam::testing::eventually;  // a departure, say, is handled on the map handler's thread
 
 // A transport whose peer events the test makes, and whose mapping peer's keyframe reader
 // matches when the test says so. It keeps the node's last announcement.

@@ -186,18 +186,22 @@ TEST(BadInput, DistributionSettingsAreReadAndChecked) {
   testing::TempDir dir;
   const fs::path file = dir / "settings.yaml";
   std::ofstream(file) << "distribution:\n  local_max_batch: 8\n  global_batch_gap_ms: 40\n  min_point_move: 0.001\n"
-                          "  point_descriptor_bits: 0\n";
+                          "  point_descriptor_bits: 0\n  lc_global_batch_gap_ms: 100\n";
   distribution::DistributionSettings s;
   applyDistributionSettings(file, s);
   EXPECT_EQ(s.local_max_batch, 8);
   EXPECT_EQ(s.global_batch_gap_ms, 40);
   EXPECT_DOUBLE_EQ(s.min_point_move, 0.001);
   EXPECT_EQ(s.point_descriptor_bits, 0);
+  EXPECT_EQ(s.lc_global_batch_gap_ms, 100);
   EXPECT_EQ(s.local_first_batch, 3);  // untouched keys keep the paper's values
   std::ofstream(file) << "distribution:\n  local_max_bach: 8\n";
   EXPECT_NE(errorOf([&] { applyDistributionSettings(file, s); }).find("distribution.local_max_bach"), std::string::npos);
   std::ofstream(file) << "distribution:\n  local_first_batch: 9\n  local_max_batch: 4\n";
   EXPECT_NE(errorOf([&] { applyDistributionSettings(file, s); }).find("out of range"), std::string::npos);
+  std::ofstream(file) << "distribution:\n  lc_global_batch_gap_ms: -1\n";
+  distribution::DistributionSettings fresh;
+  EXPECT_NE(errorOf([&] { applyDistributionSettings(file, fresh); }).find("out of range"), std::string::npos);
   std::ofstream(file) << "distribution:\n  point_normal_deg: -1\n";
   EXPECT_NE(errorOf([&] { applyDistributionSettings(file, s); }).find("point tolerances >= 0"), std::string::npos);
   std::ofstream(file) << "distribution:\n  global_batch: ten\n";
