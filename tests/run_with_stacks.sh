@@ -19,7 +19,8 @@ if command -v gdb > /dev/null; then
   for p in $procs; do
     [ "$(cat /proc/"$p"/comm 2>/dev/null)" = hiveslam ] || continue
     echo "=== $(tr '\0' ' ' < /proc/"$p"/cmdline)"
-    timeout 60 gdb -p "$p" -batch -ex 'thread apply all bt' 2>&1 | grep -E '^(Thread|#)'
+    # The binary by its /proc link: symbols resolve though it was rebuilt meanwhile.
+    timeout 60 gdb /proc/"$p"/exe -p "$p" -batch -ex 'thread apply all bt' 2>&1 | grep -E '^(Thread|#)'
   done > "$dir/stacks.log"
 fi
 kill -KILL $procs "$pid" 2>/dev/null

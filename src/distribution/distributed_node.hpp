@@ -102,6 +102,9 @@ class DistributedNode final : public core::SystemEvents {
   void globalUpdate(const core::GlobalUpdate& update) override;
 
  private:
+  // A keyframe message's target module (KeyframePublisher::Item::target).
+  static constexpr uint8_t kTargetLm = 1, kTargetLc = 2;
+
   void onPeer(const communication::PeerInfo& peer, bool present);
   // A peer's leaving notice (transport thread): what must not wait; departed() follows on the
   // map handler's thread, once the packets the peer sent before it are handled.

@@ -11,6 +11,8 @@
 #include <thread>
 #include <vector>
 
+#include "eventually.hpp"
+
 namespace hiveslam::communication {
 namespace {
 
@@ -69,6 +71,89 @@ TEST(DdsTransport, AnAnnouncementCarriesThePeersTheNodeHasHeard) {
   lock.unlock();
   b.stop();
   a.stop();
+}
+
+
+// The packet writers keep what they wrote (transient-local, see dds_transport.cpp), yet a
+// reader that matches later gets only what is written after it matched, as with volatile
+// writers: a node that joins learns the maps from a snapshot, never from old packets.
+TEST(DdsTransport, AReaderThatMatchesLateGetsOnlyWhatIsWrittenAfter) {
+  DdsTransport a({232}), b({232});
+  PeerInfo self_a, self_b;
+  self_a.node = 1;
+  self_b.node = 2;
+  a.start(self_a, [](const PeerInfo&, bool) {});
+  const auto packet = [](uint64_t seq) {
+    Message m;
+    m.source = 1;
+    m.seq = seq;
+    m.body.assign(3000, static_cast<uint8_t>(seq));  // fragmented: over one datagram
+    return m;
+  };
+  for (uint64_t seq = 1; seq <= 3; ++seq) a.publish(Topic::LmMap, packet(seq));
+  std::mutex mutex;
+  std::condition_variable got;
+  std::vector<uint64_t> received;
+  b.start(self_b, [](const PeerInfo&, bool) {});
+  b.subscribe(Topic::LmMap, [&](Message&& m) {
+    std::lock_guard lock(mutex);
+    received.push_back(m.seq);
+    got.notify_all();
+  });
+  const auto until = std::chrono::steady_clock::now() + std::chrono::seconds(10);
+  while (!a.peerReads(Topic::LmMap, 2) && std::chrono::steady_clock::now() < until)
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  ASSERT_TRUE(a.peerReads(Topic::LmMap, 2));
+  a.publish(Topic::LmMap, packet(4));
+  std::unique_lock lock(mutex);
+  ASSERT_TRUE(got.wait_for(lock, std::chrono::seconds(10), [&] { return !received.empty(); }));
+  // Anything older would have come first.
+  got.wait_for(lock, std::chrono::milliseconds(300));
+  EXPECT_EQ(received, (std::vector<uint64_t>{4}));
+  lock.unlock();
+  b.stop();
+  a.stop();
+}
+
+
+// A teardown that hangs inside Fast DDS (2.9 has lock-order deadlocks there: a TR once never
+// ended its run) is left behind once its flush time and margin are over: stop() returns, the
+// node's calls after it return at once, and the program knows to end without Fast DDS's exit
+// handlers (apps/main.cpp).
+TEST(DdsTransport, AStopThatHangsInsideFastDdsIsLeftBehind) {
+  std::mutex mutex;
+  std::condition_variable released;
+  bool release = false;
+  DdsOptions options;
+  options.domain = 232;
+  options.leave_flush_ms = 100;
+  options.teardown_margin_ms = 200;
+  options.teardown_hook = [&] {
+    std::unique_lock lock(mutex);
+    released.wait(lock, [&] { return release; });
+  };
+  DdsTransport transport(options);
+  PeerInfo self;
+  self.node = 5;
+  transport.start(self, [](const PeerInfo&, bool) {});
+  const auto start = std::chrono::steady_clock::now();
+  transport.stop();
+  const auto stopped = std::chrono::steady_clock::now();
+  EXPECT_LT(stopped - start, std::chrono::seconds(5));
+  EXPECT_GE(stopped - start, std::chrono::milliseconds(300));
+  EXPECT_EQ(DdsTransport::teardownsRunning(), 1);
+  transport.publish(Topic::LmMap, Message{});
+  transport.subscribe(Topic::LcMap, [](Message&&) {});
+  transport.unsubscribe(Topic::LcMap);
+  EXPECT_FALSE(transport.peerReads(Topic::LmMap, 1));
+  transport.stop();  // idempotent
+  EXPECT_LT(std::chrono::steady_clock::now() - stopped, std::chrono::seconds(1));
+  {
+    std::lock_guard lock(mutex);
+    release = true;
+  }
+  released.notify_all();
+  EXPECT_TRUE(testing::eventually([] { return DdsTransport::teardownsRunning() == 0; }, std::chrono::seconds(10)));
 }
 
 }  // namespace

@@ -1,6 +1,8 @@
 #pragma once
 // What a node's DDS participant is made with; the `dds:` section of a settings file overrides
 // all but the domain (io/slam_settings_io.hpp).
+#include <functional>
+
 namespace hiveslam::communication {
 
 struct DdsOptions {
@@ -19,6 +21,11 @@ struct DdsOptions {
   // its lease ends (2 s); a live one on a slow link is: over a 5 Mbit/s link the last snapshot
   // took longer than the 1 s once waited, and TR then waited 120 s for a Done that never came.
   int leave_flush_ms = 20000;
+  // stop() waits this much longer than leave_flush_ms for Fast DDS to shut down, then leaves
+  // the teardown behind (DdsTransport::teardownsRunning()).
+  int teardown_margin_ms = 10000;
+  // Tests only: runs first on the teardown thread (to stand in for a teardown that hangs).
+  std::function<void()> teardown_hook{};
 };
 
 }  // namespace hiveslam::communication

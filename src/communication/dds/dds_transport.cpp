@@ -24,6 +24,7 @@
 #include <atomic>
 #include <chrono>
 #include <condition_variable>
+#include <future>
 #include <map>
 #include <mutex>
 #include <thread>
@@ -95,6 +96,9 @@ struct DdsTransport::Impl : public dds::DomainParticipantListener {
   // table and this node's announcement (listeners take it).
   std::mutex entities;
   bool closed = true;  // no participant (before start, after stop)
+  // Set as stop() begins, read without `entities`: what is published, subscribed or asked for
+  // from then on never waits for the teardown (which may hold `entities` long, or for good).
+  std::atomic<bool> stopping{false};
   std::array<dds::DataWriter*, kTopicCount> writers{};
   struct Reader;
   std::array<std::unique_ptr<Reader>, kTopicCount> readers;
@@ -220,7 +224,13 @@ struct DdsTransport::Impl : public dds::DomainParticipantListener {
     q.reliability().max_blocking_time = Duration_t(0, 50'000'000);
     q.history().kind = dds::KEEP_LAST_HISTORY_QOS;  // a dead reader can not stall the writer
     q.history().depth = options.history_depth;
-    q.durability().kind = dds::VOLATILE_DURABILITY_QOS;
+    // Transient-local, though the readers are volatile (they get only what is written after
+    // they matched, as from a volatile writer). A volatile writer erases each packet once every
+    // reader has it, and Fast DDS 2.9 does that erasing, when a reader leaves with packets
+    // outstanding, under a lock its asynchronous sender takes in the other order: a TR that
+    // released its peers over a slow link deadlocked in 1 of 4 runs (eProsima/Fast-DDS#3468,
+    // fixed after 2.9). A transient-local writer erases only what its history depth pushes out.
+    q.durability().kind = dds::TRANSIENT_LOCAL_DURABILITY_QOS;
     q.publish_mode().kind = dds::ASYNCHRONOUS_PUBLISH_MODE;  // large packets are sent off-thread
     q.reliable_writer_qos().times.heartbeatPeriod = Duration_t(options.heartbeat_ms / 1000.0);
     auto& listener = writer_listeners[static_cast<size_t>(t)];
@@ -230,6 +240,11 @@ struct DdsTransport::Impl : public dds::DomainParticipantListener {
     if (!w) throw InputError(std::string("DDS: cannot create a writer for ") + topicName(t));
     return w;
   }
+
+  // stop()'s part inside Fast DDS: the last packets flushed, the leaving notice, the entities
+  // and the participant deleted.
+  void teardown(const PeerInfo& last);
+  void dropReader(Topic topic);
 
   // Writes happen outside `mutex`: Fast DDS delivers to a reader of the same participant on
   // the writing thread, and that reader's listener takes `mutex`.
@@ -241,7 +256,7 @@ struct DdsTransport::Impl : public dds::DomainParticipantListener {
   std::mutex write_mutex;
 };
 
-DdsTransport::DdsTransport(DdsOptions options) : impl_(std::make_unique<Impl>()) { impl_->options = options; }
+DdsTransport::DdsTransport(DdsOptions options) : impl_(std::make_shared<Impl>()) { impl_->options = std::move(options); }
 
 DdsTransport::~DdsTransport() { stop(); }
 
@@ -351,6 +366,7 @@ void DdsTransport::publish(Topic topic, Message&& m) {
   p.raw_size(m.raw_size);
   const size_t bytes = m.wireSize();
   p.body(std::move(m.body));
+  if (d.stopping) return;
   // Held through the write: stop() deletes the writers under it.
   std::lock_guard lock(d.entities);
   if (d.closed) return;
@@ -364,6 +380,7 @@ void DdsTransport::publish(Topic topic, Message&& m) {
 
 void DdsTransport::subscribe(Topic topic, Handler handler) {
   Impl& d = *impl_;
+  if (d.stopping) return;
   std::lock_guard lock(d.entities);
   // Stopping (or not started): a peer event handled during stop() subscribes as the node takes
   // a task back, and a reader made then went into a subscriber being deleted (session 36: a TR
@@ -385,14 +402,18 @@ void DdsTransport::subscribe(Topic topic, Handler handler) {
 }
 
 void DdsTransport::unsubscribe(Topic topic) {
-  Impl& d = *impl_;
-  std::unique_ptr<Impl::Reader> r;
+  if (impl_->stopping) return;  // the teardown deletes every reader
+  impl_->dropReader(topic);
+}
+
+void DdsTransport::Impl::dropReader(Topic topic) {
+  std::unique_ptr<Reader> r;
   {
-    std::lock_guard lock(d.entities);
-    r = std::move(d.readers[static_cast<size_t>(topic)]);
+    std::lock_guard lock(entities);
+    r = std::move(readers[static_cast<size_t>(topic)]);
   }
   // Deleting the reader waits for a listener call in progress to return.
-  if (r && r->reader) d.subscriber->delete_datareader(r->reader);
+  if (r && r->reader) subscriber->delete_datareader(r->reader);
 }
 
 bool DdsTransport::peerReads(Topic topic, uint16_t node) {
@@ -404,6 +425,7 @@ bool DdsTransport::peerReads(Topic topic, uint16_t node) {
     if (it == d.peers.end()) return false;
     prefix = it->second.first;
   }
+  if (d.stopping) return false;
   {
     std::lock_guard lock(d.entities);
     if (d.closed) return false;
@@ -411,6 +433,12 @@ bool DdsTransport::peerReads(Topic topic, uint16_t node) {
   std::lock_guard lock(d.match_mutex);
   return d.matched[static_cast<size_t>(topic)].count(prefix) > 0;
 }
+
+namespace {
+std::atomic<int> g_teardowns_running{0};
+}
+
+int DdsTransport::teardownsRunning() { return g_teardowns_running.load(); }
 
 void DdsTransport::stop() {
   Impl& d = *impl_;
@@ -422,28 +450,56 @@ void DdsTransport::stop() {
     last = d.self;
     d.running = false;
   }
+  d.stopping = true;
   d.wake.notify_all();
   if (d.heartbeat.joinable()) d.heartbeat.join();
+  // The teardown runs inside Fast DDS, under its locks, and Fast DDS 2.9 has lock-order
+  // deadlocks there (eProsima/Fast-DDS#3468 and #6463: a reader that leaves while the
+  // asynchronous sender writes). One must not keep a node from ending its run: its map,
+  // trajectory and report come after stop(). So the teardown gets its own thread and the time
+  // its flush may take, plus a margin; past that it is left behind (it holds the state it
+  // uses) and the program ends without running Fast DDS's exit handlers (apps/main.cpp).
+  ++g_teardowns_running;
+  auto finished = std::make_shared<std::promise<void>>();
+  auto done = finished->get_future();
+  std::thread teardown([impl = impl_, last, finished] {
+    const ScopedThreadName name("dds-teardown");
+    impl->teardown(last);
+    --g_teardowns_running;
+    finished->set_value();
+  });
+  const auto limit = std::chrono::milliseconds(d.options.leave_flush_ms + d.options.teardown_margin_ms);
+  if (done.wait_for(limit) == std::future_status::ready) {
+    teardown.join();
+    return;
+  }
+  teardown.detach();
+  spdlog::error("node {}: DDS did not shut down within {:.1f} s (a deadlock inside Fast DDS); leaving it behind",
+                d.self_node.load(), std::chrono::duration<double>(limit).count());
+}
+
+void DdsTransport::Impl::teardown(const PeerInfo& last) {
+  if (options.teardown_hook) options.teardown_hook();
   {
-    std::lock_guard lock(d.entities);
-    d.closed = true;
+    std::lock_guard lock(entities);
+    closed = true;
     // What is queued goes out before the leaving notice: a peer that hears of the leaving
     // drops its subscriptions to this node's topics, and with them the last packets (the
     // end-of-run Done was lost that way in 4 of 20 bench runs).
-    const auto until = std::chrono::steady_clock::now() + std::chrono::milliseconds(d.options.leave_flush_ms);
-    for (auto* w : d.writers) {
+    const auto until = std::chrono::steady_clock::now() + std::chrono::milliseconds(options.leave_flush_ms);
+    for (auto* w : writers) {
       const double left = std::chrono::duration<double>(until - std::chrono::steady_clock::now()).count();
       if (w && left > 0) w->wait_for_acknowledgments(Duration_t(left));
     }
   }
-  d.write(last);  // peers learn at once, not after the lease
-  if (d.node_writer) d.node_writer->wait_for_acknowledgments(Duration_t(0, 200'000'000));
-  for (int i = 0; i < kTopicCount; ++i) unsubscribe(static_cast<Topic>(i));
-  d.participant->delete_contained_entities();
-  d.peer_events.close();
-  if (d.peer_thread.joinable()) d.peer_thread.join();
-  dds::DomainParticipantFactory::get_instance()->delete_participant(d.participant);
-  d.participant = nullptr;
+  write(last);  // peers learn at once, not after the lease
+  if (node_writer) node_writer->wait_for_acknowledgments(Duration_t(0, 200'000'000));
+  for (int i = 0; i < kTopicCount; ++i) dropReader(static_cast<Topic>(i));
+  participant->delete_contained_entities();
+  peer_events.close();
+  if (peer_thread.joinable()) peer_thread.join();
+  dds::DomainParticipantFactory::get_instance()->delete_participant(participant);
+  participant = nullptr;
 }
 
 TrafficReport DdsTransport::traffic() const { return impl_->counter.report(); }

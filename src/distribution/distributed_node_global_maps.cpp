@@ -1,0 +1,118 @@
+// DistributedNode: global maps (after a loop closure, a merge or a global BA) and the epochs
+// that keep a node's keyframes of one map in one coordinate frame.
+#include <spdlog/spdlog.h>
+
+#include <algorithm>
+
+#include "core/mapping/keyframe_insertion.hpp"
+#include "distribution/distributed_node.hpp"
+
+namespace hiveslam::distribution {
+
+using communication::Task;
+using communication::Topic;
+
+void DistributedNode::globalUpdate(const core::GlobalUpdate& u) {
+  auto map = slam_.findMap(u.map);
+  if (!map) return;
+  std::vector<core::Id> merged;
+  if (u.merged_map != core::kNoId) merged.push_back(u.merged_map);
+  std::lock_guard lock(mutex_);
+  // The map is in this epoch's frame from now on, for what this node sends and what it takes.
+  const auto note = [&](uint64_t e) {
+    std::lock_guard map_lock(map->mutex);
+    integrator_.noteEpoch(*map, e);
+  };
+  if (options_.task == Task::LoopClosing) {
+    const uint64_t e = std::max(published_[u.map], synced_[u.map]) + 1;
+    published_[u.map] = synced_[u.map] = e;
+    note(e);
+    handler_->sendGlobal(map, e, Topic::LcMap, merged);
+  } else if (plan_.local_maps && !peers_.empty()) {
+    const uint64_t e = ++synced_[u.map];
+    note(e);
+    handler_->sendGlobal(map, e, Topic::LmMap, merged);
+  }
+}
+
+void DistributedNode::onGlobal(std::vector<MapRecord>&& batches, Topic topic) {
+  const core::Id map_id = batches.front().map;
+  const uint64_t epoch = batches.front().epoch;
+  if (topic == Topic::LcMap) {
+    // The gateway applies LC's update, then relays its own full state of the map: LC's update
+    // plus what LM made meanwhile, in one coordinate frame.
+    integrator_.applyGlobal(batches, false);
+    std::vector<core::Id> merged;
+    for (const auto& b : batches) merged.insert(merged.end(), b.merged_maps.begin(), b.merged_maps.end());
+    auto map = slam_.findMap(map_id);
+    {
+      std::lock_guard lock(mutex_);
+      synced_[map_id] = std::max(synced_[map_id], epoch);
+      if (map) handler_->sendGlobal(map, epoch, Topic::LmMap, merged);
+    }
+    releaseHeld(map_id);
+    return;
+  }
+  bool ignore = false;
+  {
+    std::lock_guard lock(mutex_);
+    auto it = published_.find(map_id);
+    // LC takes the relay of its latest update only: an older one would undo a newer correction.
+    if (it != published_.end() && it->second != epoch) {
+      ++globals_ignored_;
+      ignore = true;
+      spdlog::info("node {}: global map {} of epoch {} ignored (this node published epoch {})", options_.id, map_id,
+                   epoch, it->second);
+    }
+  }
+  if (!ignore && integrator_.applyGlobal(batches, true)) {
+    {
+      std::lock_guard lock(mutex_);
+      synced_[map_id] = std::max(synced_[map_id], epoch);
+    }
+    releaseHeld(map_id);
+    return;
+  }
+  if (!ignore) {
+    std::lock_guard lock(mutex_);
+    ++globals_ignored_;  // older than the map here (a correction made here, not yet out)
+    spdlog::info("node {}: global map {} of epoch {} ignored (the map here has left that frame)", options_.id, map_id,
+                 epoch);
+  }
+  // Still, what is new here (points LM made) and what LM erased is taken, and the keyframes a
+  // snapshot brings that this node never got: the one a mapping node mapped as it died, those
+  // the node that took mapping back mapped after it gave mapping up again. Without them LC
+  // ended such runs two keyframes short of TR and LM.
+  for (const auto& b : batches) integrator_.applyLocal(b);  // labelled older: stale here
+  for (const auto& a : integrator_.addMissing(batches)) {
+    std::lock_guard lock(a.map->mutex);
+    core::insertKeyframe(*a.map, *a.keyframe, slam_.scales(), &slam_.database());
+  }
+}
+
+uint64_t DistributedNode::knownEpoch(core::Id map) const {
+  uint64_t e = 0;
+  if (auto it = synced_.find(map); it != synced_.end()) e = it->second;
+  if (auto it = published_.find(map); it != published_.end()) e = std::max(e, it->second);
+  return e;
+}
+
+void DistributedNode::releaseHeld(core::Id map) {
+  // Runs on the map handler's thread, like every other apply: arrival order is kept.
+  std::vector<MapRecord> ready;
+  {
+    std::lock_guard lock(mutex_);
+    const uint64_t now = knownEpoch(map);
+    for (auto it = held_.begin(); it != held_.end();) {
+      if (it->map == map && it->epoch <= now) {
+        ready.push_back(std::move(*it));
+        it = held_.erase(it);
+      } else {
+        ++it;
+      }
+    }
+  }
+  for (const auto& m : ready) integrator_.applyLocal(m);
+}
+
+}  // namespace hiveslam::distribution
