@@ -111,7 +111,7 @@ std::string benchRules(const nlohmann::json& rows) {
   for (const auto& n : order) sequences.push_back(by_name[n]);
   const auto checks = eval::checkBenchRules(sequences);
   if (checks.empty()) return "";
-  return "acceptance (issue 5), from the runs above:\n" + eval::ruleTable(checks);
+  return "acceptance (issue 5), from the runs above:\n" + eval::ruleTable(checks) + eval::pairedCpuLine(sequences);
 }
 
 nlohmann::json BenchRow::toJson() const {

@@ -67,4 +67,20 @@ std::string ruleTable(const std::vector<RuleCheck>& checks) {
   return t;
 }
 
+std::string pairedCpuLine(const std::vector<SequenceRuns>& sequences) {
+  std::string t = fmt::format("{:<30}", "TR CPU per pair, min-max");
+  bool any = false;
+  for (const auto& s : sequences) {
+    const auto &cpu1 = s.one_node.tr_cpu_seconds, &cpu3 = s.three_nodes.tr_cpu_seconds;
+    if (s.one_node.ate_m.empty() || s.three_nodes.ate_m.empty()) continue;  // as checkBenchRules
+    std::vector<double> ratios;
+    for (size_t i = 0; i < std::min(cpu1.size(), cpu3.size()); ++i)
+      if (cpu1[i] > 0) ratios.push_back(cpu3[i] / cpu1[i]);
+    const auto [lo, hi] = std::minmax_element(ratios.begin(), ratios.end());
+    t += ratios.empty() ? fmt::format(" {:>17}", "-") : fmt::format(" {:>17}", fmt::format("{:.2f}-{:.2f}", *lo, *hi));
+    any = true;
+  }
+  return any ? t + "\n" : "";
+}
+
 }  // namespace hiveslam::eval

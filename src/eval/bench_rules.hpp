@@ -44,4 +44,10 @@ std::vector<RuleCheck> checkBenchRules(const std::vector<SequenceRuns>& sequence
 // A rule per line, a sequence per column: "value/limit ok" or "value/limit FAIL".
 std::string ruleTable(const std::vector<RuleCheck>& checks);
 
+// Not a rule: the TR CPU ratio of each interleaved pair (run i of each configuration, made one
+// after the other), as "min-max" per sequence, in the rule table's columns. A pair shares the
+// machine's speed of the moment, which drifts by 15% and more between runs: the spread of the
+// pairs says how far a bench's ratio of medians is the machine's.
+std::string pairedCpuLine(const std::vector<SequenceRuns>& sequences);
+
 }  // namespace hiveslam::eval

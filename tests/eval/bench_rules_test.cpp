@@ -84,5 +84,22 @@ TEST(BenchRules, TheTableSaysOkOrFailPerSequence) {
   EXPECT_NE(t.find("1.00/1.50 ok"), std::string::npos) << t;
 }
 
+// Each pair is run i of one configuration against run i of the other: 12/20, 9/15, 12/20, 9/15
+// and 11/20 give 0.55-0.60 (the rule itself takes the medians, 11/20).
+TEST(BenchRules, ThePairedCpuLineGivesTheRangeOfThePairsRatios) {
+  auto a = sequence({.006, .006, .006, .006, .006}, {.006, .006, .006, .006, .006}, {20, 15, 20, 15, 20},
+                    {12, 9, 12, 9, 11});
+  auto b = sequence({.006, .006}, {.006, .006}, {10, 10}, {5, 6});
+  a.sequence = "alpha";
+  b.sequence = "beta";
+  const std::string line = pairedCpuLine({a, b});
+  EXPECT_NE(line.find("0.55-0.60"), std::string::npos) << line;
+  EXPECT_NE(line.find("0.50-0.60"), std::string::npos) << line;
+  // In the rule table's columns: a 30-character label, then 18 characters per sequence.
+  EXPECT_EQ(line.find("0.55-0.60") + 9, 30u + 18u) << line;
+  EXPECT_EQ(line.find("0.50-0.60") + 9, 30u + 36u) << line;
+  EXPECT_EQ(pairedCpuLine({}), "");
+}
+
 }  // namespace
 }  // namespace hiveslam::eval
