@@ -73,7 +73,6 @@ TEST(DdsTransport, AnAnnouncementCarriesThePeersTheNodeHasHeard) {
   a.stop();
 }
 
-
 // The packet writers keep what they wrote (transient-local, see dds_transport.cpp), yet a
 // reader that matches later gets only what is written after it matched, as with volatile
 // writers: a node that joins learns the maps from a snapshot, never from old packets.
@@ -100,10 +99,7 @@ TEST(DdsTransport, AReaderThatMatchesLateGetsOnlyWhatIsWrittenAfter) {
     received.push_back(m.seq);
     got.notify_all();
   });
-  const auto until = std::chrono::steady_clock::now() + std::chrono::seconds(10);
-  while (!a.peerReads(Topic::LmMap, 2) && std::chrono::steady_clock::now() < until)
-    std::this_thread::sleep_for(std::chrono::milliseconds(10));
-  ASSERT_TRUE(a.peerReads(Topic::LmMap, 2));
+  ASSERT_TRUE(testing::eventually([&] { return a.peerReads(Topic::LmMap, 2); }, std::chrono::seconds(10)));
   a.publish(Topic::LmMap, packet(4));
   std::unique_lock lock(mutex);
   ASSERT_TRUE(got.wait_for(lock, std::chrono::seconds(10), [&] { return !received.empty(); }));
@@ -114,7 +110,6 @@ TEST(DdsTransport, AReaderThatMatchesLateGetsOnlyWhatIsWrittenAfter) {
   b.stop();
   a.stop();
 }
-
 
 // A teardown that hangs inside Fast DDS (2.9 has lock-order deadlocks there: a TR once never
 // ended its run) is left behind once its flush time and margin are over: stop() returns, the

@@ -355,6 +355,7 @@ void DdsTransport::announce(const PeerInfo& self) {
 
 void DdsTransport::publish(Topic topic, Message&& m) {
   Impl& d = *impl_;
+  if (d.stopping) return;
   hiveslam_msgs::msg::Packet p;
   p.version(m.version);
   p.source(m.source);
@@ -366,7 +367,6 @@ void DdsTransport::publish(Topic topic, Message&& m) {
   p.raw_size(m.raw_size);
   const size_t bytes = m.wireSize();
   p.body(std::move(m.body));
-  if (d.stopping) return;
   // Held through the write: stop() deletes the writers under it.
   std::lock_guard lock(d.entities);
   if (d.closed) return;
@@ -454,8 +454,8 @@ void DdsTransport::stop() {
   d.wake.notify_all();
   if (d.heartbeat.joinable()) d.heartbeat.join();
   // The teardown runs inside Fast DDS, under its locks, and Fast DDS 2.9 has lock-order
-  // deadlocks there (eProsima/Fast-DDS#3468 and #6463: a reader that leaves while the
-  // asynchronous sender writes). One must not keep a node from ending its run: its map,
+  // deadlocks there (eProsima/Fast-DDS#3468: a reader that leaves while the asynchronous sender
+  // writes; #6463: a tear-down while a peer still delivers). One must not keep a node from ending its run: its map,
   // trajectory and report come after stop(). So the teardown gets its own thread and the time
   // its flush may take, plus a margin; past that it is left behind (it holds the state it
   // uses) and the program ends without running Fast DDS's exit handlers (apps/main.cpp).
