@@ -160,10 +160,13 @@ std::string nodeDigest(const fs::path& node) {
     << r.value("map_points", -1) << ", maps " << r.value("maps", -1);
   if (r.contains("tracked_frames")) o << ", tracked " << r.value("tracked_frames", -1);
   if (r.contains("ate")) o << ", ATE " << r["ate"].value("percent_of_path", -1.0) << "% (max " << r["ate"].value("max", -1.0) << " m)";
+  // How far a global BA's free scale wandered before it was restored (1: none ran).
+  if (r.contains("global_ba_scale_drift")) o << ", global BA scale drift " << r.value("global_ba_scale_drift", -1.0);
   o << "\n";
   for (const auto& e : r.value("loop_events", nlohmann::json::array()))
     o << "  " << e.value("kind", "") << " at " << e.value("timestamp", 0.0) << " to " << e.value("place_timestamp", 0.0)
-      << ": " << e.value("matches", 0) << " matches, scale " << e.value("scale", 0.0) << "\n";
+      << ": " << e.value("matches", 0) << " matches, scale " << e.value("scale", 0.0) << " (agreed by "
+      << e.value("scale_agreement", 0.0) << " of the inliers)\n";
   std::ifstream frames(node / "frames.csv");
   std::string line, last_map, first;
   std::getline(frames, line);  // the header
