@@ -160,7 +160,7 @@ std::string nodeDigest(const fs::path& node) {
     << r.value("map_points", -1) << ", maps " << r.value("maps", -1);
   if (r.contains("tracked_frames")) o << ", tracked " << r.value("tracked_frames", -1);
   if (r.contains("ate")) o << ", ATE " << r["ate"].value("percent_of_path", -1.0) << "% (max " << r["ate"].value("max", -1.0) << " m)";
-  // How far a global BA's free scale wandered before it was restored (1: none ran).
+  // The most a global BA's free scale wandered before it was put back (1: none wandered or ran).
   if (r.contains("global_ba_scale_drift")) o << ", global BA scale drift " << r.value("global_ba_scale_drift", -1.0);
   o << "\n";
   for (const auto& e : r.value("loop_events", nlohmann::json::array()))
