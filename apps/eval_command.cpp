@@ -2,6 +2,7 @@
 // hiveslam eval scale-step GT EST and scale-precision ATLAS: a monocular run's scale step
 // between two stretches, and how precisely the map's own measurements could fix it.
 // hiveslam eval bench DIR/bench.json: a saved bench's table and acceptance rules, again.
+// hiveslam eval remeasure ATLAS DATASET: a saved map on patch-aligned observations (eval_remeasure).
 #include <fmt/format.h>
 
 #include <nlohmann/json.hpp>
@@ -10,6 +11,7 @@
 
 #include "apps/bench.hpp"
 #include "apps/commands.hpp"
+#include "apps/eval_remeasure.hpp"
 #include "common/error.hpp"
 #include "eval/scale_precision.hpp"
 #include "eval/scale_step.hpp"
@@ -185,6 +187,20 @@ void addEvalCommand(CLI::App& app) {
     fmt::print("residual noise {:.3f} sigma per coordinate; {} trials at {:.3f} sigma\n", r.residual_noise, r.steps.size(),
                r.noise);
     fmt::print("scale step: mean {:.4f}, sd {:.4f} ({:.2f}%)\n", r.mean, r.sd, 100.0 * r.sd);
+  });
+
+  auto remeasure_atlas = std::make_shared<std::string>(), remeasure_dataset = std::make_shared<std::string>();
+  auto remeasure_split = std::make_shared<eval::StretchSplit>();
+  auto remeasure_map = std::make_shared<long>(-1);
+  auto* remeasure_cmd = eval->add_subcommand(
+      "remeasure", "A saved map bundle-adjusted on its corners and on patch-aligned observations, against ground truth");
+  remeasure_cmd->add_option("ATLAS", *remeasure_atlas, "Atlas file (hiveslam run --atlas-out)")->required();
+  remeasure_cmd->add_option("DATASET", *remeasure_dataset, "The dataset the map was made from (its images and ground truth)")
+      ->required();
+  addSplit(remeasure_cmd, *remeasure_split);
+  remeasure_cmd->add_option("--map", *remeasure_map, "Map id (default: the one with the most keyframes)");
+  remeasure_cmd->callback([=]() {
+    evalRemeasure(pickMap(io::loadAtlas(*remeasure_atlas), *remeasure_map), *remeasure_dataset, *remeasure_split);
   });
 
   auto bench_file = std::make_shared<std::string>();

@@ -7,6 +7,7 @@
 #include "core/features/orb_extractor.hpp"
 #include "synth/renderer.hpp"
 #include "synth/sequence.hpp"
+#include "core/rendered_sweep.hpp"
 
 namespace hiveslam::features {
 namespace {
@@ -126,11 +127,7 @@ TEST(OrbExtractor, DescriptorsAreTheRotatedBriefTestsBitForBit) {
 // the same corners found there (same level, similar descriptor, nearest). Per matched pair, in
 // level pixels; both views' errors are in it.
 std::vector<double> pairErrors(bool subpixel, double& rms_per_coordinate) {
-  synth::SequenceOptions o;
-  o.trajectory = "sweep";
-  o.seed = 4;
-  o.frames = 800;
-  const auto model = synth::buildSequence(o);
+  const auto model = testing::renderedSweep();
   const synth::RayTable rays(model.lens);
   OrbOptions options;
   options.subpixel = subpixel;

@@ -30,6 +30,7 @@ MapBaProblem buildMapBaProblem(const Map& map, const std::vector<double>& level_
       const auto& kp = k->frame.keypoints[static_cast<size_t>(idx)];
       ba.observations.push_back({it->second, static_cast<int>(i), k->frame.points[static_cast<size_t>(idx)],
                                  1.0 / level_scales[static_cast<size_t>(kp.octave)]});
+      out.sources.emplace_back(k, idx);
     }
     ba.points.push_back({p->position, false});
   }

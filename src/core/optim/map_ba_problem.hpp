@@ -13,6 +13,8 @@ struct MapBaProblem {
   BaProblem problem;
   std::vector<KeyFrame*> keyframes;  // problem.poses order, by id
   std::vector<MapPoint*> points;     // problem.points order, by id
+  // Per observation (problem.observations order): the keyframe and its keypoint index.
+  std::vector<std::pair<KeyFrame*, int>> sources;
 };
 
 // The caller holds map.mutex. `level_scales`: the scale of each pyramid level.

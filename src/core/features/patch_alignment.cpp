@@ -1,0 +1,85 @@
+#include "core/features/patch_alignment.hpp"
+
+#include <Eigen/Dense>
+#include <algorithm>
+#include <cmath>
+
+
+namespace hiveslam::features {
+
+std::optional<Patch> sampleWarpedPatch(const ImagePyramid& reference, const ImagePyramid& searched, int level,
+                                       cv::Point2d centre, const PixelWarp& warp, int half) {
+  const auto toReference = [&](double dx, double dy) -> std::optional<Eigen::Vector2d> {
+    const cv::Point2d p = searched.toLevel0(level, centre + cv::Point2d(dx, dy));
+    return warp(Eigen::Vector2d(p.x, p.y));
+  };
+  // The reference level: one searched pixel spans about one of its pixels.
+  const auto at = toReference(0, 0), right = toReference(1, 0), down = toReference(0, 1);
+  if (!at || !right || !down) return std::nullopt;
+  const double spacing = std::sqrt((*right - *at).norm() * (*down - *at).norm());
+  const double scale = reference.scaleFactor();
+  int ref_level = 0;
+  if (spacing > 0 && scale > 1.0)
+    ref_level = std::clamp(static_cast<int>(std::lround(std::log(spacing) / std::log(scale))), 0, reference.levels() - 1);
+  Patch patch;
+  patch.half = half;
+  patch.values.resize(static_cast<size_t>(patch.side() * patch.side()));
+  for (int r = 0; r < patch.side(); ++r)
+    for (int c = 0; c < patch.side(); ++c) {
+      const auto p = toReference(patch.offset(c), patch.offset(r));
+      if (!p) return std::nullopt;
+      const cv::Point2d q = reference.toLevel(ref_level, {p->x(), p->y()});
+      const float v = sampleBilinear(reference.level(ref_level), q.x, q.y);
+      if (std::isnan(v)) return std::nullopt;
+      patch.values[static_cast<size_t>(r * patch.side() + c)] = v;
+    }
+  return patch;
+}
+
+std::optional<PatchAlignment> alignPatch(const cv::Mat& image, const Patch& patch, cv::Point2d start,
+                                         const PatchAlignmentOptions& options) {
+  CV_Assert(image.type() == CV_8UC1);
+  const int n = patch.side();
+  CV_Assert(static_cast<int>(patch.values.size()) == n * n);
+  PatchAlignment a;
+  a.position = start;
+  for (a.iterations = 1; a.iterations <= options.max_iterations; ++a.iterations) {
+    // Unknowns: shift x, shift y, gain, bias. Residual: image - (gain patch + bias).
+    Eigen::Matrix4d H = Eigen::Matrix4d::Zero();
+    Eigen::Vector4d g = Eigen::Vector4d::Zero();
+    for (int r = 0; r < n; ++r)
+      for (int c = 0; c < n; ++c) {
+        const double x = a.position.x + patch.offset(c), y = a.position.y + patch.offset(r);
+        const float I = sampleBilinear(image, x, y);
+        // Gradients by central differences half a pixel either side: on the bilinear surface
+        // they are the slopes of the cells the sample sits between.
+        const float Ix = sampleBilinear(image, x + 0.5, y) - sampleBilinear(image, x - 0.5, y);
+        const float Iy = sampleBilinear(image, x, y + 0.5) - sampleBilinear(image, x, y - 0.5);
+        if (std::isnan(I) || std::isnan(Ix) || std::isnan(Iy)) return std::nullopt;
+        const double t = patch.values[static_cast<size_t>(r * n + c)];
+        const double e = I - a.gain * t - a.bias;
+        const Eigen::Vector4d J(Ix, Iy, -t, -1.0);
+        H.noalias() += J * J.transpose();
+        g.noalias() += J * e;
+      }
+    if (a.iterations == 1) {
+      const Eigen::Matrix2d shift_block = H.topLeftCorner<2, 2>() / static_cast<double>(n * n);
+      const double weaker = Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d>(shift_block, Eigen::EigenvaluesOnly).eigenvalues()(0);
+      if (weaker < options.min_gradient * options.min_gradient) return std::nullopt;
+    }
+    const Eigen::Vector4d step = -H.ldlt().solve(g);
+    if (!step.allFinite()) return std::nullopt;
+    a.position += cv::Point2d(step[0], step[1]);
+    a.gain += step[2];
+    a.bias += step[3];
+    const double moved = std::hypot(a.position.x - start.x, a.position.y - start.y);
+    if (moved > 3 * options.max_shift_px) return std::nullopt;  // diverging; the first steps may overshoot
+    if (std::hypot(step[0], step[1]) < options.converged_px) {
+      if (moved > options.max_shift_px || a.gain < options.min_gain || a.gain > options.max_gain) return std::nullopt;
+      return a;
+    }
+  }
+  return std::nullopt;
+}
+
+}  // namespace hiveslam::features

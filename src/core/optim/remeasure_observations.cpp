@@ -1,0 +1,76 @@
+#include "core/optim/remeasure_observations.hpp"
+
+#include <unordered_map>
+
+#include "core/geometry/plane_warp.hpp"
+#include "core/map/keyframe.hpp"
+
+namespace hiveslam::core {
+
+RemeasureStats remeasureObservations(MapBaProblem& mp, const camera::CameraModel& camera, const KeyframeImages& images,
+                                     const RemeasureOptions& options) {
+  RemeasureStats stats;
+  BaProblem& ba = mp.problem;
+  std::vector<Eigen::Vector3d> positions;
+  for (const BaPoint& p : ba.points) positions.push_back(p.p_w);
+  const auto normals = planeNormals(positions, options.normals);
+  const auto poseOf = [&](int i) {
+    Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+    T.linear() = ba.poses[static_cast<size_t>(i)].q_cw.toRotationMatrix();
+    T.translation() = ba.poses[static_cast<size_t>(i)].t_cw;
+    return T;
+  };
+  // Each point's anchor: its observation in the earliest keyframe (the lowest id).
+  std::vector<int> anchor(ba.points.size(), -1);
+  for (size_t o = 0; o < ba.observations.size(); ++o) {
+    int& a = anchor[static_cast<size_t>(ba.observations[o].point)];
+    if (a < 0 || mp.sources[o].first->id < mp.sources[static_cast<size_t>(a)].first->id) a = static_cast<int>(o);
+  }
+  for (size_t o = 0; o < ba.observations.size(); ++o) {
+    BaObservation& ob = ba.observations[o];
+    const size_t point = static_cast<size_t>(ob.point);
+    const size_t a = static_cast<size_t>(anchor[point]);
+    if (a == o) {
+      ++stats.anchors;
+      continue;
+    }
+    const KeyFrame& kf = *mp.sources[o].first;
+    const KeyFrame& anchor_kf = *mp.sources[a].first;
+    const features::ImagePyramid* here = images(kf);
+    const features::ImagePyramid* there = images(anchor_kf);
+    const cv::KeyPoint& kp = kf.frame.keypoints[static_cast<size_t>(mp.sources[o].second)];
+    if (!here || !there || kp.octave >= here->levels()) {
+      ++stats.kept;
+      continue;
+    }
+    const Eigen::Isometry3d T_here = poseOf(ob.pose), T_there = poseOf(ba.observations[a].pose);
+    const Eigen::Vector3d X = ba.points[point].p_w, anchor_centre = T_there.inverse().translation();
+    Eigen::Vector3d n = (anchor_centre - X).normalized();  // facing the anchor, unless the neighbours say otherwise
+    if (normals[point]) n = normals[point]->dot(n) < 0 ? Eigen::Vector3d(-*normals[point]) : *normals[point];
+    // The anchor's corner on that plane, and where it falls in this view: the patch's centre.
+    const cv::KeyPoint& anchor_kp = anchor_kf.frame.keypoints[static_cast<size_t>(mp.sources[a].second)];
+    const auto into_here = geometry::PlaneWarp::through(camera, T_there, T_here, X, n);
+    const auto centre0 = into_here(Eigen::Vector2d(anchor_kp.pt.x, anchor_kp.pt.y));
+    if (!centre0) {
+      ++stats.kept;
+      continue;
+    }
+    const auto into_anchor = geometry::PlaneWarp::through(camera, T_here, T_there, X, n);
+    const cv::Point2d centre = here->toLevel(kp.octave, {centre0->x(), centre0->y()});
+    const auto patch = features::sampleWarpedPatch(*there, *here, kp.octave, centre, into_anchor, options.patch_half);
+    const auto found = patch ? features::alignPatch(here->level(kp.octave), *patch, here->toLevel(kp.octave, kp.pt), options.alignment)
+                             : std::nullopt;
+    if (!found) {
+      ++stats.kept;
+      continue;
+    }
+    const cv::Point2d at = here->toLevel0(kp.octave, found->position);
+    const Eigen::Vector3d ray = camera.unproject({at.x, at.y});
+    ob.uv = ba.K.project(ray);
+    ++stats.aligned;
+  }
+  for (const auto& n : normals) stats.plane_normals += n.has_value();
+  return stats;
+}
+
+}  // namespace hiveslam::core
