@@ -4,7 +4,6 @@
 #include <algorithm>
 #include <cmath>
 
-
 namespace hiveslam::features {
 
 std::optional<Patch> sampleWarpedPatch(const ImagePyramid& reference, const ImagePyramid& searched, int level,
