@@ -2,12 +2,12 @@
 
 #include <fmt/format.h>
 
-#include <algorithm>
 #include <map>
 
 #include "common/error.hpp"
 #include "core/features/orb_extractor.hpp"
 #include "core/optim/remeasure_observations.hpp"
+#include "core/system/slam_settings.hpp"
 #include "eval/trajectory_error.hpp"
 #include "io/open_dataset.hpp"
 
@@ -24,8 +24,7 @@ double finalBundleAdjustment(core::BaProblem& ba) {
   loose.iterations = 50;
   loose.outliers = core::Outliers::Kept;
   core::bundleAdjust(ba, loose);
-  const double sigma = std::clamp(1.5 * core::medianResidualSigma(ba), 0.1, 1.0);
-  core::setNoise(ba, sigma);
+  const double sigma = core::setNoiseFromResiduals(ba, core::SlamSettings{}.global_ba_noise_factor);
   core::BaOptions tight;
   tight.iterations = 50;
   tight.outliers = core::Outliers::SecondRound;
@@ -35,12 +34,7 @@ double finalBundleAdjustment(core::BaProblem& ba) {
 
 io::Trajectory keyframeTrajectory(const core::BaProblem& ba, const std::vector<double>& stamps) {
   io::Trajectory t;
-  for (size_t i = 0; i < ba.poses.size(); ++i) {
-    Eigen::Isometry3d T_cw = Eigen::Isometry3d::Identity();
-    T_cw.linear() = ba.poses[i].q_cw.toRotationMatrix();
-    T_cw.translation() = ba.poses[i].t_cw;
-    t.add(stamps[i], T_cw.inverse());
-  }
+  for (size_t i = 0; i < ba.poses.size(); ++i) t.add(stamps[i], ba.poses[i].T_cw().inverse());
   return t;
 }
 

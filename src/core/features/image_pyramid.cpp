@@ -10,7 +10,7 @@ ImagePyramid::ImagePyramid(const cv::Mat& gray, int levels, double scale_factor)
   CV_Assert(gray.type() == CV_8UC1);
   double s = 1.0;
   for (int l = 0; l < levels; ++l, s *= scale_factor) {
-    const cv::Size size = l == 0 ? gray.size() : cv::Size(cvRound(gray.cols / s), cvRound(gray.rows / s));
+    const cv::Size size = pyramidLevelSize(gray.size(), s);
     if (size.width < 2 || size.height < 2) break;
     cv::Mat m;
     if (l == 0) m = gray;

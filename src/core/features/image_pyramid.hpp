@@ -27,6 +27,12 @@ class ImagePyramid {
   double scale_factor_ = 1.0;
 };
 
+// The size of the pyramid level at `scale` (1 for level 0) of an image of size `level0`: the
+// extractor's levels and ImagePyramid's must agree to the pixel.
+inline cv::Size pyramidLevelSize(cv::Size level0, double scale) {
+  return {cvRound(level0.width / scale), cvRound(level0.height / scale)};
+}
+
 // Bilinear sample of an 8-bit image at a sub-pixel position (pixel centres on integers), or
 // NaN where the 2x2 neighbourhood leaves the image.
 float sampleBilinear(const cv::Mat& gray, double x, double y);

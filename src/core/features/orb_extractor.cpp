@@ -10,6 +10,7 @@
 #include <queue>
 
 #include "core/features/brief_pattern.hpp"
+#include "core/features/image_pyramid.hpp"
 #include "core/features/corner_refinement.hpp"
 
 namespace hiveslam::features {
@@ -272,7 +273,7 @@ void OrbExtractor::extract(const cv::Mat& gray, std::vector<cv::KeyPoint>& keypo
   int n_desc = 0;
   for (int level = 0; level < options_.levels; ++level) {
     const double s = scales_[static_cast<size_t>(level)];
-    const cv::Size size = level == 0 ? gray.size() : cv::Size(cvRound(gray.cols / s), cvRound(gray.rows / s));
+    const cv::Size size = pyramidLevelSize(gray.size(), s);
     if (size.width < 2 * kBorder || size.height < 2 * kBorder) break;
     cv::Mat& padded = scratch.padded[static_cast<size_t>(level)];
     padded.create(size.height + 2 * kBorder, size.width + 2 * kBorder, CV_8U);

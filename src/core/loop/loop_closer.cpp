@@ -460,10 +460,7 @@ void LoopCloser::globalBundleAdjustment(Map& map, int iterations, bool corrected
   o.outliers = Outliers::Kept;
   if (settings_.global_ba_noise_factor > 0) {
     // Observations the map's own noise calls outliers sit this BA out; they stay in the map.
-    // A tenth of a pixel at the least: a map fitted exactly (a test's noiseless one) would
-    // otherwise call every rounding error an outlier.
-    const double sigma = std::clamp(settings_.global_ba_noise_factor * medianResidualSigma(ba), 0.1, 1.0);
-    setNoise(ba, sigma);
+    const double sigma = setNoiseFromResiduals(ba, settings_.global_ba_noise_factor);
     o.outliers = settings_.global_ba_outliers_from_start && !corrected ? Outliers::FromStart : Outliers::SecondRound;
     stats_.global_ba_sigma = sigma;
   }

@@ -262,11 +262,7 @@ void LocalMapper::applyLocalBa(Map& map, LocalBa& ba) {
     return;
   }
   ++stats_.local_bas;
-  for (size_t k = 0; k < ba.keyframes.size(); ++k) {
-    const auto& pose = ba.problem.poses[k];
-    ba.keyframes[k]->T_cw.linear() = pose.q_cw.normalized().toRotationMatrix();
-    ba.keyframes[k]->T_cw.translation() = pose.t_cw;
-  }
+  for (size_t k = 0; k < ba.keyframes.size(); ++k) ba.keyframes[k]->T_cw = ba.problem.poses[k].T_cw();
   for (size_t i = 0; i < ba.points.size(); ++i)
     if (!ba.points[i]->bad) ba.points[i]->position = ba.problem.points[i].p_w;
   for (size_t i = 0; i < ba.observations.size(); ++i) {

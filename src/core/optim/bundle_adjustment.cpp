@@ -141,4 +141,10 @@ void setNoise(BaProblem& pb, double sigma) {
   for (auto& ob : pb.observations) ob.inv_sigma /= sigma;
 }
 
+double setNoiseFromResiduals(BaProblem& pb, double factor) {
+  const double sigma = std::clamp(factor * medianResidualSigma(pb), 0.1, 1.0);
+  setNoise(pb, sigma);
+  return sigma;
+}
+
 }  // namespace hiveslam::core

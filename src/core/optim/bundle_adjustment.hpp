@@ -14,6 +14,13 @@ struct BaPose {
   Eigen::Quaterniond q_cw = Eigen::Quaterniond::Identity();
   Eigen::Vector3d t_cw = Eigen::Vector3d::Zero();
   bool fixed = false;
+
+  Eigen::Isometry3d T_cw() const {
+    Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+    T.linear() = q_cw.normalized().toRotationMatrix();
+    T.translation() = t_cw;
+    return T;
+  }
 };
 
 struct BaPoint {
@@ -77,5 +84,9 @@ double medianResidualSigma(const BaProblem& problem);
 // measurements are more precise than one pixel per level), so that the Huber kernel and the
 // chi-square test of the outlier round judge residuals against the noise the map really has.
 void setNoise(BaProblem& problem, double sigma);
+// setNoise with `factor` times the noise medianResidualSigma reads, clamped to 0.1-1 px per level
+// (a tenth of a pixel at the least: a map fitted exactly, a test's noiseless one, would otherwise
+// call every rounding error an outlier). Returns the sigma set.
+double setNoiseFromResiduals(BaProblem& problem, double factor);
 
 }  // namespace hiveslam::core

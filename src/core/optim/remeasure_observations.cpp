@@ -14,12 +14,6 @@ RemeasureStats remeasureObservations(MapBaProblem& mp, const camera::CameraModel
   std::vector<Eigen::Vector3d> positions;
   for (const BaPoint& p : ba.points) positions.push_back(p.p_w);
   const auto normals = planeNormals(positions, options.normals);
-  const auto poseOf = [&](int i) {
-    Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
-    T.linear() = ba.poses[static_cast<size_t>(i)].q_cw.toRotationMatrix();
-    T.translation() = ba.poses[static_cast<size_t>(i)].t_cw;
-    return T;
-  };
   // Each point's anchor: its observation in the earliest keyframe (the lowest id).
   std::vector<int> anchor(ba.points.size(), -1);
   for (size_t o = 0; o < ba.observations.size(); ++o) {
@@ -43,7 +37,8 @@ RemeasureStats remeasureObservations(MapBaProblem& mp, const camera::CameraModel
       ++stats.kept;
       continue;
     }
-    const Eigen::Isometry3d T_here = poseOf(ob.pose), T_there = poseOf(ba.observations[a].pose);
+    const Eigen::Isometry3d T_here = ba.poses[static_cast<size_t>(ob.pose)].T_cw();
+    const Eigen::Isometry3d T_there = ba.poses[static_cast<size_t>(ba.observations[a].pose)].T_cw();
     const Eigen::Vector3d X = ba.points[point].p_w, anchor_centre = T_there.inverse().translation();
     Eigen::Vector3d n = (anchor_centre - X).normalized();  // facing the anchor, unless the neighbours say otherwise
     if (normals[point]) n = normals[point]->dot(n) < 0 ? Eigen::Vector3d(-*normals[point]) : *normals[point];

@@ -206,8 +206,7 @@ bool Tracker::initialize(Tracked& current, TrackingOutput& out) {
     BaOptions bo;
     bo.iterations = 20;
     const BaSummary s = bundleAdjust(ba, bo);
-    kf2->T_cw.linear() = ba.poses[1].q_cw.normalized().toRotationMatrix();
-    kf2->T_cw.translation() = ba.poses[1].t_cw;
+    kf2->T_cw = ba.poses[1].T_cw();
     for (size_t i = 0; i < pts.size(); ++i) pts[i]->position = ba.points[i].p_w;
     for (size_t i = 0; i < ba.observations.size(); ++i)
       if (s.outlier[i]) {
