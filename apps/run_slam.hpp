@@ -5,6 +5,7 @@
 
 #include "core/loop/loop_closer.hpp"
 #include "core/mapping/local_mapper.hpp"
+#include "core/system/slam_system.hpp"
 #include <string>
 #include <vector>
 
@@ -41,6 +42,8 @@ struct RunOptions {
 // Each loop closure and merge as a report entry: kind, timestamp of the keyframe that
 // recognized the place, matches, the Sim3's scale (the drift seen), timings.
 nlohmann::json loopEventsJson(const core::LoopStats& stats);
+// The re-measurement of observations before the final global BA (SlamSettings::remeasure).
+nlohmann::json remeasureJson(const core::SlamSystem::RemeasureReport& r);
 // Local mapping's counts (keyframes processed and culled, points made and culled, local BAs).
 nlohmann::json mappingStatsJson(const core::MappingStats& stats);
 

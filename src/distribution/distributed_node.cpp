@@ -58,7 +58,8 @@ DistributedNode::DistributedNode(core::SlamSystem& slam, communication::Transpor
           slam_.submit(a.map, a.keyframe, core::SlamSystem::Module::Mapping);
         }
       },
-      [this](const Message& m) { onControl(m, Topic::TrKeyframes); }, [this](core::Id id, uint8_t target) { awaitMap(id, target); });
+      [this](const Message& m) { onControl(m, Topic::TrKeyframes); }, [this](core::Id id, uint8_t target) { awaitMap(id, target); },
+      [this](const core::Remeasurements& r) { slam_.addRemeasurements(r); });
   MapHandler::Hooks hooks;
   hooks.hold = [this](const MapRecord& m) {
     {

@@ -117,6 +117,10 @@ class DistributedNode final : public core::SystemEvents {
   void onControl(const communication::Message& m, communication::Topic topic);
   // The gateway's part of the end of a run. Returns whether the LC (if any) answered.
   bool finishAsGateway();
+  // End of a run: observations measured again (by TR, which alone holds the keyframes' images)
+  // go to the next node towards loop closing, ahead of the end-of-sequence packet on `topic`,
+  // for the final global BA (SlamSettings::remeasure).
+  void pushRemeasurements(const core::Remeasurements& r, communication::Topic topic);
   // A newcomer gets this node's maps so far (see Hand-over above).
   void sendMapsTo(const communication::PeerInfo& peer);
   // LC, once its mapping node has left: the global maps that node had not relayed yet never

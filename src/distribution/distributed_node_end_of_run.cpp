@@ -85,10 +85,29 @@ void DistributedNode::onControl(const Message& m, Topic topic) {
   }
 }
 
+void DistributedNode::pushRemeasurements(const core::Remeasurements& r, Topic topic) {
+  // A few packets of at most 20 keyframes (a sweep run: some 28,000 observations, 150 KB).
+  constexpr size_t kKeyframesPerPacket = 20;
+  core::Remeasurements part;
+  const auto send = [&] {
+    auto m = std::make_shared<Message>(pack(part, options_.id, 0, 0, 0));
+    publisher_->push({nullptr, nullptr, topic, 0, false, std::move(m)});
+    part.clear();
+  };
+  for (const auto& [keyframe, entries] : r) {
+    part.emplace(keyframe, entries);
+    if (part.size() == kKeyframesPerPacket) send();
+  }
+  if (!part.empty()) send();
+}
+
 bool DistributedNode::finishAsGateway() {
   slam_.drain();
   bool answered = true;
   if (plan().keyframes_to_lc) {
+    // A TR that maps now measures its own keyframes here; an LM passes on what TR sent.
+    slam_.remeasureOwnKeyframes();
+    pushRemeasurements(slam_.remeasurements(), Topic::LmKeyframes);
     publisher_->push({nullptr, nullptr, Topic::LmKeyframes, static_cast<uint8_t>(Control::EndOfSequence)});
     std::unique_lock lock(mutex_);
     answered = changed_.wait_for(lock, std::chrono::seconds(60), [&] { return lc_done_ || !plan_.keyframes_to_lc; }) && lc_done_;
@@ -117,6 +136,7 @@ bool DistributedNode::finishRun(std::chrono::milliseconds timeout) {
     run_hosted_ = p.hosted;
   }
   if (p.keyframes_to_lm) {
+    pushRemeasurements(slam_.remeasureOwnKeyframes(), Topic::TrKeyframes);
     publisher_->push({nullptr, nullptr, Topic::TrKeyframes, static_cast<uint8_t>(Control::EndOfSequence)});
     // The Done comes from the gateway: one that leaves first sends none, and this node then
     // maps what it had sent it and ends without (it waited out the whole timeout before). The

@@ -48,6 +48,11 @@ void KeyframePublisher::publish(const Job& job) {
     return;
   }
   if (await_readers_) await_readers_(job.topic);
+  if (job.packet) {
+    communication::Message m = *job.packet;
+    transport_.publish(job.topic, std::move(m));
+    return;
+  }
   if (!job.keyframe) {  // a control packet, in order after the keyframes before it
     transport_.publish(job.topic, controlPacket(node_, static_cast<Control>(job.target)));
     return;

@@ -26,6 +26,8 @@ class KeyframePublisher {
     // No packet: the map went to a newcomer in a snapshot, so its next keyframe goes without
     // the map's earlier keyframes as companions.
     bool handed_over = false;
+    // A packet made elsewhere (observations measured again), sent in its turn as it is.
+    std::shared_ptr<const communication::Message> packet = nullptr;
   };
   // known(point): the receivers of `topic` already have the point.
   using Known = std::function<bool(communication::Topic, core::Id)>;

@@ -7,8 +7,13 @@
 
 namespace hiveslam::distribution {
 
-KeyframeSubscriber::KeyframeSubscriber(StateIntegrator& integrator, Route route, OnControl control, AwaitMap await_map)
-    : integrator_(integrator), route_(std::move(route)), control_(std::move(control)), await_map_(std::move(await_map)) {
+KeyframeSubscriber::KeyframeSubscriber(StateIntegrator& integrator, Route route, OnControl control, AwaitMap await_map,
+                                       OnRemeasured remeasured)
+    : integrator_(integrator),
+      route_(std::move(route)),
+      control_(std::move(control)),
+      await_map_(std::move(await_map)),
+      remeasured_(std::move(remeasured)) {
   thread_ = std::thread([this] {
     nameThisThread("kf-subscriber");
     loop();
@@ -29,6 +34,11 @@ void KeyframeSubscriber::loop() {
       continue;
     }
     try {
+      if (m->kind == static_cast<uint8_t>(PacketKind::Remeasured)) {
+        const core::Remeasurements r = decodeRemeasurements(unpack(*m, PacketKind::Remeasured));
+        if (remeasured_) remeasured_(r);
+        continue;
+      }
       const KeyFrameMessage k = decodeKeyframe(unpack(*m, PacketKind::Keyframe));
       ++received_;
       if (k.companions.empty() && await_map_) await_map_(k.keyframe.map, m->target);
@@ -36,7 +46,7 @@ void KeyframeSubscriber::loop() {
       if (added.keyframe) route_(added, m->target);
     } catch (const std::exception& e) {
       ++dropped_;
-      spdlog::warn("dropped a keyframe message from node {}: {}", m->source, e.what());
+      spdlog::warn("dropped a keyframe-topic message from node {}: {}", m->source, e.what());
     }
   }
 }

@@ -21,7 +21,10 @@ class KeyframeSubscriber {
   // Returns once the map is held here or waiting longer makes no sense. `target`: the
   // module the keyframe is for (which tells whom to ask for the map).
   using AwaitMap = std::function<void(Id map, uint8_t target)>;
-  KeyframeSubscriber(StateIntegrator& integrator, Route route, OnControl control, AwaitMap await_map = {});
+  // Observations the sender measured again (end of a run), in order with its keyframes.
+  using OnRemeasured = std::function<void(const core::Remeasurements&)>;
+  KeyframeSubscriber(StateIntegrator& integrator, Route route, OnControl control, AwaitMap await_map = {},
+                     OnRemeasured remeasured = {});
   ~KeyframeSubscriber();
   void push(communication::Message&& m) { queue_.push(std::move(m)); }
   void finish();
@@ -35,6 +38,7 @@ class KeyframeSubscriber {
   Route route_;
   OnControl control_;
   AwaitMap await_map_;
+  OnRemeasured remeasured_;
   BlockingQueue<communication::Message> queue_;
   std::atomic<int> received_{0}, dropped_{0};
   std::thread thread_;

@@ -11,7 +11,9 @@ communication::Message pack(const Record& record, uint16_t source, uint8_t targe
   communication::Message m;
   m.version = kWireVersion;
   m.source = source;
-  m.kind = static_cast<uint8_t>(std::is_same_v<Record, MapRecord> ? PacketKind::Map : PacketKind::Keyframe);
+  m.kind = static_cast<uint8_t>(std::is_same_v<Record, MapRecord>              ? PacketKind::Map
+                                : std::is_same_v<Record, core::Remeasurements> ? PacketKind::Remeasured
+                                                                               : PacketKind::Keyframe);
   m.target = target;
   m.map = map;
   m.epoch = epoch;

@@ -83,6 +83,8 @@ void applySlamSettings(const std::filesystem::path& file, core::SlamSettings& s)
       {"global_ba_outliers_from_start", set(s.global_ba_outliers_from_start)},
       {"global_ba_every_keyframes", set(s.global_ba_every_keyframes)},
       {"final_global_ba_iterations", set(s.final_global_ba_iterations)},
+      {"remeasure", set(s.remeasure)},
+      {"remeasure_image_budget_mb", set(s.remeasure_image_budget_mb)},
       {"refine_frames", set(s.refine_frames)},
       {"vocabulary", set(s.vocabulary)},
       {"seed", set(s.seed)},

@@ -96,8 +96,9 @@ TEST(RemeasureObservations, BringsTheLaterViewsOntoTheTrueProjections) {
     return std::sqrt(sum / (2.0 * static_cast<double>(n)));
   };
   const BaProblem found = ba;
+  Remeasurements measured;
   const RemeasureStats stats =
-      remeasureObservations(mp, cam, [&](const KeyFrame& k) { return &images.at(&k); });
+      remeasureObservations(mp, cam, [&](const KeyFrame& k) { return &images.at(&k); }, {}, &measured);
   EXPECT_EQ(stats.anchors, ba.points.size());
   EXPECT_GT(stats.aligned, 0.9 * static_cast<double>(ba.observations.size() - ba.points.size()));
   EXPECT_GT(stats.plane_normals, 0.5 * static_cast<double>(ba.points.size()));
@@ -109,6 +110,14 @@ TEST(RemeasureObservations, BringsTheLaterViewsOntoTheTrueProjections) {
   // patch, land on its projections.
   EXPECT_LT(after, 0.1) << before << " -> " << after;
   EXPECT_LT(after, 0.5 * before) << before << " -> " << after;
+
+  // What travels to loop closing (by keyframe and keypoint) gives the same observations again.
+  EXPECT_EQ(remeasurementCount(measured), stats.aligned);
+  MapBaProblem again = mp;
+  again.problem.observations = found.observations;
+  EXPECT_EQ(applyRemeasurements(again, measured), stats.aligned);
+  for (size_t i = 0; i < moved.size(); ++i)
+    EXPECT_LT((again.problem.observations[i].uv - mp.problem.observations[i].uv).norm(), 1e-4) << i;
 }
 
 }  // namespace

@@ -84,6 +84,7 @@ struct ClusterRun {
   int mapped_by_tr = 0, mapped_by_new_lm = 0;  // keyframes local mapping processed there
   double ate_fraction = 1.0;  // ATE RMSE over the path length
   int loops = 0, merges = 0;
+  size_t remeasured_tr = 0, remeasured_lc = 0;  // observations TR measured again; those LC's final BA used
   size_t maps_tr = 0, maps_lm = 0, maps_lc = 0;
   int lc_maps_asked_for = 0;
 };
@@ -154,6 +155,8 @@ ClusterRun runThreeNodes(const std::string& trajectory, int frames, Outage outag
   run.maps_tr = tr.liveMaps().size();
   run.maps_lm = mapper.liveMaps().size();
   run.maps_lc = lc.liveMaps().size();
+  run.remeasured_tr = tr.remeasureReport().own;
+  run.remeasured_lc = lc.remeasureReport().total;
   run.mapped_by_tr = tr.mappingStats().keyframes_processed;
   run.mapped_by_new_lm = lm2.mappingStats().keyframes_processed;
   run.lc_maps_asked_for = n_lc.report(1.0).value("maps_asked_for", 0);
@@ -179,6 +182,9 @@ TEST(InProcCluster, ThreeNodesTrackCloseTheLoopAndAgree) {
   EXPECT_LT(run.ate_fraction, 0.01);
   EXPECT_GE(run.loops, 1);
   EXPECT_EQ(run.mapped_by_tr, 0);  // TR mapped nothing itself
+  // TR alone holds the images: it measured the observations again, and LC's final BA got them all.
+  EXPECT_GT(run.remeasured_tr, 1000u);
+  EXPECT_EQ(run.remeasured_lc, run.remeasured_tr);
 }
 
 // The mapping node leaves a third of the way round; TR maps alone (LC stays). It comes back at

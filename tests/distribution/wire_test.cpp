@@ -93,6 +93,41 @@ TEST(Wire, MalformedBodiesAreRejected) {
   EXPECT_THROW(unpack(pack(sampleKeyframe(), 1, 1, 7, 0), PacketKind::Map), WireError);
 }
 
+TEST(Wire, RemeasurementsRoundTripInSteps) {
+  core::Remeasurements r;
+  r[42] = {{3, {0.25f, -0.125f}}, {17, {1.0f / 512, 2.0f}}, {900, {-100.0f, 0.0f}}};
+  r[7] = {{0, {0.0f, 0.01f}}};
+  r[8] = {{5, {400.0f, 0.0f}}};  // farther than any alignment moves: left out
+  const auto packet = pack(r, 1, 0, 0, 0);
+  EXPECT_EQ(packet.kind, static_cast<uint8_t>(PacketKind::Remeasured));
+  const core::Remeasurements back = decodeRemeasurements(unpack(packet, PacketKind::Remeasured));
+  ASSERT_EQ(back.size(), 3u);
+  EXPECT_TRUE(back.at(8).empty());
+  ASSERT_EQ(back.at(42).size(), 3u);
+  for (size_t i = 0; i < 3; ++i) {
+    EXPECT_EQ(back.at(42)[i].keypoint, r[42][i].keypoint);
+    EXPECT_NEAR(back.at(42)[i].shift.x(), r[42][i].shift.x(), 1.0 / 512);
+    EXPECT_NEAR(back.at(42)[i].shift.y(), r[42][i].shift.y(), 1.0 / 512);
+  }
+  EXPECT_NEAR(back.at(7)[0].shift.y(), 0.01f, 1.0 / 512);
+  // Truncated, or keypoints out of order: dropped, never misread.
+  const auto raw = encode(r);
+  for (size_t cut : {size_t{1}, raw.size() / 2, raw.size() - 1}) {
+    std::vector<uint8_t> truncated(raw.begin(), raw.begin() + static_cast<std::ptrdiff_t>(cut));
+    EXPECT_THROW(decodeRemeasurements(truncated), WireError) << cut;
+  }
+  ByteWriter w;
+  w.put(uint32_t{1});
+  w.varint(10);        // keyframe id
+  w.put(uint32_t{2});  // two entries
+  for (int i = 0; i < 2; ++i) {
+    w.varint(i == 0 ? 5 : 0);  // the second one repeats keypoint 5
+    w.put(int16_t{1});
+    w.put(int16_t{1});
+  }
+  EXPECT_THROW(decodeRemeasurements(w.data()), WireError);
+}
+
 TEST(Policy, TrackingFollowsThePapersFourCases) {
   using communication::taskBit;
   const uint8_t lm = taskBit(Task::Mapping), lc = taskBit(Task::LoopClosing);

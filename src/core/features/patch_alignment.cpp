@@ -1,5 +1,7 @@
 #include "core/features/patch_alignment.hpp"
 
+#include <array>
+
 #include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
@@ -20,14 +22,32 @@ std::optional<Patch> sampleWarpedPatch(const ImagePyramid& reference, const Imag
   int ref_level = 0;
   if (spacing > 0 && scale > 1.0)
     ref_level = std::clamp(static_cast<int>(std::lround(std::log(spacing) / std::log(scale))), 0, reference.levels() - 1);
+  // The warp is smooth across one patch: taken through the camera model on a 3x3 grid over the
+  // patch and interpolated quadratically between (nine warps instead of one per pixel; the
+  // distortion's inversion made the per-pixel warp most of the re-measurement's time).
+  const double h = std::max(half, 1);
+  std::array<Eigen::Vector2d, 9> grid;
+  for (int j = 0; j < 3; ++j)
+    for (int i = 0; i < 3; ++i) {
+      const auto p = i == 1 && j == 1 ? at : toReference((i - 1) * h, (j - 1) * h);
+      if (!p) return std::nullopt;
+      grid[static_cast<size_t>(j * 3 + i)] = *p;
+    }
+  // Lagrange weights of the nodes -h, 0, h at t.
+  const auto weights = [h](double t) -> std::array<double, 3> {
+    const double u = t / h;
+    return {0.5 * u * (u - 1), 1 - u * u, 0.5 * u * (u + 1)};
+  };
   Patch patch;
   patch.half = half;
   patch.values.resize(static_cast<size_t>(patch.side() * patch.side()));
   for (int r = 0; r < patch.side(); ++r)
     for (int c = 0; c < patch.side(); ++c) {
-      const auto p = toReference(patch.offset(c), patch.offset(r));
-      if (!p) return std::nullopt;
-      const cv::Point2d q = reference.toLevel(ref_level, {p->x(), p->y()});
+      const auto wx = weights(patch.offset(c)), wy = weights(patch.offset(r));
+      Eigen::Vector2d p = Eigen::Vector2d::Zero();
+      for (int j = 0; j < 3; ++j)
+        for (int i = 0; i < 3; ++i) p += wx[static_cast<size_t>(i)] * wy[static_cast<size_t>(j)] * grid[static_cast<size_t>(j * 3 + i)];
+      const cv::Point2d q = reference.toLevel(ref_level, {p.x(), p.y()});
       const float v = sampleBilinear(reference.level(ref_level), q.x, q.y);
       if (std::isnan(v)) return std::nullopt;
       patch.values[static_cast<size_t>(r * patch.side() + c)] = v;

@@ -439,7 +439,7 @@ void LoopCloser::optimizeEssentialGraph(Map& map, const LoopCorrection& c, LoopE
   event.essential_graph_ms = msSince(t0);
 }
 
-void LoopCloser::globalBundleAdjustment(Map& map, int iterations, bool corrected) {
+void LoopCloser::globalBundleAdjustment(Map& map, int iterations, bool corrected, const Remeasurements* remeasured) {
   const auto t0 = std::chrono::steady_clock::now();
   MapBaProblem whole;
   uint64_t epoch = 0;
@@ -455,8 +455,15 @@ void LoopCloser::globalBundleAdjustment(Map& map, int iterations, bool corrected
   if (kfs.size() < 3) return;
   PoseCorrection correction;
   for (size_t i = 0; i < kfs.size(); ++i) correction.before[kfs[i]] = Sim3(ba.poses[i].q_cw, ba.poses[i].t_cw, 1.0);
+  const std::vector<Eigen::Vector3d> centres = cameraCentres(ba);
   BaOptions o;
   o.iterations = iterations > 0 ? iterations : settings_.global_ba_iterations;
+  if (remeasured && applyRemeasurements(whole, *remeasured) > 0) {
+    BaOptions loose;
+    loose.iterations = o.iterations;
+    loose.outliers = Outliers::Kept;
+    bundleAdjust(ba, loose);
+  }
   o.outliers = Outliers::Kept;
   if (settings_.global_ba_noise_factor > 0) {
     // Observations the map's own noise calls outliers sit this BA out; they stay in the map.
@@ -464,7 +471,6 @@ void LoopCloser::globalBundleAdjustment(Map& map, int iterations, bool corrected
     o.outliers = settings_.global_ba_outliers_from_start && !corrected ? Outliers::FromStart : Outliers::SecondRound;
     stats_.global_ba_sigma = sigma;
   }
-  const std::vector<Eigen::Vector3d> centres = cameraCentres(ba);
   bundleAdjust(ba, o);
   const double restored = restoreScale(ba, centres);  // only the origin is fixed: the scale was free (scale_gauge.hpp)
   stats_.global_ba_scale_drift = std::max({stats_.global_ba_scale_drift, restored, 1.0 / restored});

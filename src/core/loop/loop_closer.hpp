@@ -19,6 +19,7 @@
 
 #include "core/geometry/sim3.hpp"
 #include "core/map/map.hpp"
+#include "core/optim/remeasurements.hpp"
 #include "core/place/keyframe_database.hpp"
 #include "core/system/slam_settings.hpp"
 
@@ -71,7 +72,13 @@ class LoopCloser {
   // update; the end of a run asks for one (SlamSystem::drain). On the loop closing thread, or
   // where no other module runs; the caller holds no lock. `corrected`: a loop or merge has just
   // moved the map, so its starting residuals do not tell outliers from a seam still open.
-  void globalBundleAdjustment(Map& map, int iterations = 0, bool corrected = false);
+  // `remeasured`: observations measured again (the end of a run): they replace the detected ones,
+  // and a loose solve (a pixel per level, nothing left out) goes first. Judged at once against
+  // the map's tight noise, the observations that would pull the map into its new shape look
+  // like outliers and sit out: the map stayed at its old scale step (docs/BENCHMARKS.md,
+  // session 47).
+  void globalBundleAdjustment(Map& map, int iterations = 0, bool corrected = false,
+                              const Remeasurements* remeasured = nullptr);
 
  private:
   // A recognized place with its covisibility group (keyframe ids), for the consistency test.

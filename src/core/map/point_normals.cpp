@@ -2,6 +2,7 @@
 
 #include <Eigen/Eigenvalues>
 #include <algorithm>
+#include <opencv2/flann.hpp>
 
 namespace hiveslam::core {
 
@@ -10,17 +11,23 @@ std::vector<std::optional<Eigen::Vector3d>> planeNormals(const std::vector<Eigen
   std::vector<std::optional<Eigen::Vector3d>> out(points.size());
   const size_t k = static_cast<size_t>(std::max(options.neighbours, 3));
   if (points.size() <= k) return out;
-  std::vector<std::pair<double, size_t>> by_distance(points.size());
+  // Exact k-nearest search in a kd-tree (unlimited checks): the same neighbours as an exhaustive
+  // search, in O(n log n) instead of O(n^2) (a second for 15,000 points before).
+  cv::Mat cloud(static_cast<int>(points.size()), 3, CV_32F);
+  for (size_t i = 0; i < points.size(); ++i)
+    for (int c = 0; c < 3; ++c) cloud.at<float>(static_cast<int>(i), c) = static_cast<float>(points[i](c));
+  cv::flann::Index tree(cloud, cv::flann::KDTreeIndexParams(1));
+  cv::Mat indices, distances;
+  // The point itself is the nearest (distance 0): k neighbours are the first k + 1.
+  tree.knnSearch(cloud, indices, distances, static_cast<int>(k + 1), cv::flann::SearchParams(cvflann::FLANN_CHECKS_UNLIMITED));
   for (size_t i = 0; i < points.size(); ++i) {
-    for (size_t j = 0; j < points.size(); ++j) by_distance[j] = {(points[j] - points[i]).squaredNorm(), j};
-    // The point itself is the nearest (distance 0): k neighbours are the first k + 1.
-    std::nth_element(by_distance.begin(), by_distance.begin() + static_cast<long>(k), by_distance.end());
+    const int* near = indices.ptr<int>(static_cast<int>(i));
     Eigen::Vector3d mean = Eigen::Vector3d::Zero();
-    for (size_t a = 0; a <= k; ++a) mean += points[by_distance[a].second];
+    for (size_t a = 0; a <= k; ++a) mean += points[static_cast<size_t>(near[a])];
     mean /= static_cast<double>(k + 1);
     Eigen::Matrix3d scatter = Eigen::Matrix3d::Zero();
     for (size_t a = 0; a <= k; ++a) {
-      const Eigen::Vector3d d = points[by_distance[a].second] - mean;
+      const Eigen::Vector3d d = points[static_cast<size_t>(near[a])] - mean;
       scatter.noalias() += d * d.transpose();
     }
     const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(scatter);  // eigenvalues ascending

@@ -20,7 +20,7 @@ struct PlaneNormalOptions {
 
 // One entry per point: the unit normal of its neighbourhood's plane (sign arbitrary), or nothing
 // where there are too few points or they are not flat (an edge, a corner, a curved surface).
-// Exhaustive neighbour search: O(n^2), about a second for 15,000 points.
+// Exact neighbour search in a kd-tree.
 std::vector<std::optional<Eigen::Vector3d>> planeNormals(const std::vector<Eigen::Vector3d>& points,
                                                          const PlaneNormalOptions& options = {});
 

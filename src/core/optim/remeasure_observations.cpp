@@ -1,5 +1,6 @@
 #include "core/optim/remeasure_observations.hpp"
 
+#include <algorithm>
 #include <unordered_map>
 
 #include "core/geometry/plane_warp.hpp"
@@ -8,7 +9,7 @@
 namespace hiveslam::core {
 
 RemeasureStats remeasureObservations(MapBaProblem& mp, const camera::CameraModel& camera, const KeyframeImages& images,
-                                     const RemeasureOptions& options) {
+                                     const RemeasureOptions& options, Remeasurements* measured) {
   RemeasureStats stats;
   BaProblem& ba = mp.problem;
   std::vector<Eigen::Vector3d> positions;
@@ -63,8 +64,15 @@ RemeasureStats remeasureObservations(MapBaProblem& mp, const camera::CameraModel
     const Eigen::Vector3d ray = camera.unproject({at.x, at.y});
     ob.uv = ba.K.project(ray);
     ++stats.aligned;
+    if (measured) {
+      const auto idx = static_cast<size_t>(mp.sources[o].second);
+      (*measured)[kf.id].push_back({static_cast<uint32_t>(idx), (ob.uv - kf.frame.points[idx]).cast<float>()});
+    }
   }
   for (const auto& n : normals) stats.plane_normals += n.has_value();
+  if (measured)
+    for (auto& [id, entries] : *measured)
+      std::sort(entries.begin(), entries.end(), [](const Remeasurement& a, const Remeasurement& b) { return a.keypoint < b.keypoint; });
   return stats;
 }
 

@@ -17,6 +17,7 @@
 #include "core/features/patch_alignment.hpp"
 #include "core/map/point_normals.hpp"
 #include "core/optim/map_ba_problem.hpp"
+#include "core/optim/remeasurements.hpp"
 
 namespace hiveslam::core {
 
@@ -37,8 +38,8 @@ struct RemeasureStats {
 using KeyframeImages = std::function<const features::ImagePyramid*(const KeyFrame&)>;
 
 // Replaces the `uv` of the observations of `mp` (buildMapBaProblem, with its poses and points)
-// by re-measured ones. The caller holds the map's mutex.
+// by re-measured ones, and adds each to `measured` when given. The caller holds the map's mutex.
 RemeasureStats remeasureObservations(MapBaProblem& mp, const camera::CameraModel& camera, const KeyframeImages& images,
-                                     const RemeasureOptions& options = {});
+                                     const RemeasureOptions& options = {}, Remeasurements* measured = nullptr);
 
 }  // namespace hiveslam::core

@@ -97,6 +97,15 @@ struct SlamSettings {
   // 5.2-6.3 -> 5.0-6.1 mm), real-time ones gain (figure8: 9.1 9.8 8.1 -> 5.8 6.9 7.6 mm):
   // docs/BENCHMARKS.md, session 14.
   int final_global_ba_iterations = 50;
+  // Before that final BA: every observation of the maps measured again by patch alignment
+  // against its point's first view (optim/remeasure_observations.hpp), by the node that made the
+  // keyframes and holds their images, and the final BA runs loose (a pixel per level, nothing
+  // left out) before its usual noise-scaled solve. Re-detected corners move with the view by a
+  // few tenths of a pixel and bend sweep's maps through the turn; on saved maps this halved the
+  // scale step's spread (0.21% -> 0.10%) and the keyframe ATE (docs/BENCHMARKS.md, session 47).
+  bool remeasure = true;
+  // The keyframe images kept for it (level 0, 361 KB each at 752x480); past it, none more.
+  int remeasure_image_budget_mb = 512;
   // At the end of a run (SlamSystem::refineFrames): each tracked frame is posed again against
   // the final map from the matches it was tracked with. A frame is otherwise held relative to
   // its reference keyframe as it was when tracked, and keeps the map's error of that moment.

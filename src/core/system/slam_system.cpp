@@ -1,11 +1,14 @@
 #include "core/system/slam_system.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <thread>
 
 #include "common/thread_name.hpp"
 #include "core/mapping/keyframe_insertion.hpp"
+#include "core/optim/map_ba_problem.hpp"
 #include "core/optim/pose_optimizer.hpp"
+#include "core/optim/remeasure_observations.hpp"
 
 namespace hiveslam::core {
 
@@ -28,6 +31,7 @@ SlamSystem::SlamSystem(const SlamSettings& settings, std::shared_ptr<const camer
       tracker_(settings_, ids_, extractor_.scales()),
       mapper_(settings_, ids_, extractor_.scales()),
       closer_(settings_, database_, extractor_.scales()),
+      images_(static_cast<size_t>(std::max(settings.remeasure_image_budget_mb, 0)) << 20),
       mode_(mode) {
   if (vocabulary_ && !vocabulary_->empty()) {
     tracker_.setPlaceRecognition(vocabulary_.get(), &database_);
@@ -74,7 +78,7 @@ void SlamSystem::loopLoop() {
     if (job->keyframe)
       closer_.process(job->map, job->keyframe);
     else
-      closer_.globalBundleAdjustment(*job->map->resolve(), settings_.final_global_ba_iterations);
+      finalBundleAdjustment(*job->map->resolve());
     --loop_jobs_pending_;
   }
 }
@@ -140,16 +144,79 @@ void SlamSystem::drain() {
   // Everything is mapped: the last global BA, where loop closing runs, so that its result
   // reaches the other nodes as every global update does.
   const bool final_ba = hosting_loop_closing_ && settings_.final_global_ba_iterations > 0;
-  if (final_ba && !final_ba_done_.exchange(true))
+  if (final_ba && !final_ba_done_.exchange(true)) {
+    // Measured on the maps as loop closing leaves them.
+    while (loop_jobs_pending_ > 0) std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    if (settings_.remeasure) remeasureOwnKeyframes();
     for (const auto& map : liveMaps()) {
       if (mode_ == Mode::Sequential) {
-        closer_.globalBundleAdjustment(*map, settings_.final_global_ba_iterations);
+        finalBundleAdjustment(*map);
       } else {
         ++loop_jobs_pending_;
         loop_jobs_.push({map, nullptr});
       }
     }
+  }
   while (loop_jobs_pending_ > 0) std::this_thread::sleep_for(std::chrono::milliseconds(5));
+}
+
+void SlamSystem::finalBundleAdjustment(Map& map) {
+  const Remeasurements r = remeasurements();
+  closer_.globalBundleAdjustment(map, settings_.final_global_ba_iterations, false, r.empty() ? nullptr : &r);
+}
+
+Remeasurements SlamSystem::remeasureOwnKeyframes() {
+  {
+    std::lock_guard lock(remeasured_mutex_);
+    if (remeasured_own_) return own_remeasured_;
+  }
+  Remeasurements out;
+  RemeasureReport report;
+  if (!images_.empty()) {
+    const auto t0 = std::chrono::steady_clock::now();
+    RemeasureStats& total = report.stats;
+    const int levels = settings_.orb.levels;
+    const double scale_factor = settings_.orb.scale_factor;
+    for (const auto& map : liveMaps()) {
+      std::lock_guard lock(map->mutex);
+      MapBaProblem whole = buildMapBaProblem(*map, extractor_.scales());
+      const RemeasureStats s = remeasureObservations(
+          whole, *camera_, [&](const KeyFrame& k) { return images_.pyramid(k.id, levels, scale_factor); }, {}, &out);
+      total.anchors += s.anchors;
+      total.aligned += s.aligned;
+      total.kept += s.kept;
+      total.plane_normals += s.plane_normals;
+    }
+    images_.releasePyramids();
+    report.ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  }
+  std::lock_guard lock(remeasured_mutex_);
+  if (!remeasured_own_) {
+    remeasured_own_ = true;
+    own_remeasured_ = out;
+    remeasure_report_ = report;
+    mergeRemeasurements(remeasured_, out);
+  }
+  return own_remeasured_;
+}
+
+void SlamSystem::addRemeasurements(const Remeasurements& r) {
+  std::lock_guard lock(remeasured_mutex_);
+  mergeRemeasurements(remeasured_, r);
+}
+
+Remeasurements SlamSystem::remeasurements() const {
+  std::lock_guard lock(remeasured_mutex_);
+  return remeasured_;
+}
+
+SlamSystem::RemeasureReport SlamSystem::remeasureReport() const {
+  std::lock_guard lock(remeasured_mutex_);
+  RemeasureReport r = remeasure_report_;
+  r.image_mb = static_cast<double>(images_.bytes()) / (1 << 20);
+  r.own = remeasurementCount(own_remeasured_);
+  r.total = remeasurementCount(remeasured_);
+  return r;
 }
 
 bool SlamSystem::mappingIdle() const {
@@ -212,6 +279,7 @@ const FrameRecord& SlamSystem::process(const cv::Mat& gray, double timestamp) {
     r.observations = std::move(out.observations);
   }
   if (out.new_keyframe) {
+    if (settings_.remeasure) images_.keep(out.new_keyframe->id, gray);
     // Mapping may have gone to another node while this frame was tracked. Decided again under
     // the lock that counts queued keyframes, a newcomer's snapshot (which waits for
     // mappingIdle) either waits for this keyframe or the keyframe goes to the new mapper.

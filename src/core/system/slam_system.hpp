@@ -17,6 +17,8 @@
 #include "core/camera/camera_model.hpp"
 #include "core/loop/loop_closer.hpp"
 #include "core/mapping/local_mapper.hpp"
+#include "core/optim/remeasure_observations.hpp"
+#include "core/system/keyframe_image_store.hpp"
 #include "core/system/system_events.hpp"
 #include "core/tracking/tracker.hpp"
 
@@ -87,8 +89,26 @@ class SlamSystem {
   // The end of a run: blocks until the queued keyframes of the hosted modules are done, then,
   // where loop closing is hosted, runs the final global BA of every map
   // (SlamSettings::final_global_ba_iterations) on the loop closing thread and waits for it.
-  // Only the first call does the final BA.
+  // Only the first call does the final BA. With SlamSettings::remeasure, the observations of
+  // the keyframes made here are measured again first (remeasureOwnKeyframes), and the final BA
+  // uses them with those received from other nodes (addRemeasurements).
   void drain();
+  // Measures again every observation, in the live maps, of the keyframes whose images this node
+  // kept (those it tracked), once: later calls return the first result. Holds each map's mutex
+  // while it measures (the end of a run, tracking done). Empty without images.
+  Remeasurements remeasureOwnKeyframes();
+  // Observations another node measured again, for this node's final global BA.
+  void addRemeasurements(const Remeasurements& r);
+  // What this node has: measured here and received.
+  Remeasurements remeasurements() const;
+  struct RemeasureReport {
+    RemeasureStats stats;  // of the pass over this node's own keyframes
+    double ms = 0;         // its time
+    double image_mb = 0;   // keyframe images kept for it
+    size_t own = 0;        // observations it measured again
+    size_t total = 0;      // with those received
+  };
+  RemeasureReport remeasureReport() const;
   // Whether local mapping has no keyframe queued or in hand (after setHosting took mapping
   // away, what it still maps changes this node's maps only).
   bool mappingIdle() const;
@@ -134,6 +154,12 @@ class SlamSystem {
   std::function<void()> remote_wait_;
   std::atomic<int> loop_jobs_pending_{0};
   std::atomic<bool> final_ba_done_{false};
+  KeyframeImageStore images_;
+  mutable std::mutex remeasured_mutex_;  // guards the four below
+  Remeasurements remeasured_;
+  bool remeasured_own_ = false;
+  Remeasurements own_remeasured_;
+  RemeasureReport remeasure_report_;
 
   struct MappingJob {
     std::shared_ptr<Map> map;
@@ -143,6 +169,8 @@ class SlamSystem {
   // What local mapping calls before its local BA: the keyframeTriangulated event, if anyone listens.
   std::function<void()> beforeBa(const std::shared_ptr<Map>& map, const std::shared_ptr<KeyFrame>& kf) const;
   void loopLoop();
+  // The final global BA of `map`, with the observations measured again so far.
+  void finalBundleAdjustment(Map& map);
   void waitForMapping();
   Mode mode_;
   BlockingQueue<MappingJob> jobs_;

@@ -260,6 +260,71 @@ MapRecord decodeMap(const std::vector<uint8_t>& raw) {
   return m;
 }
 
+namespace {
+
+constexpr float kShiftStep = 1.0f / 256.0f;
+
+bool quantize(float shift, int16_t& out) {
+  const float q = std::round(shift / kShiftStep);
+  if (!(std::abs(q) <= 32767.0f)) return false;  // NaN too
+  out = static_cast<int16_t>(q);
+  return true;
+}
+
+}  // namespace
+
+std::vector<uint8_t> encode(const core::Remeasurements& m) {
+  ByteWriter w;
+  w.put(static_cast<uint32_t>(m.size()));
+  uint64_t previous_keyframe = 0;
+  for (const auto& [keyframe, entries] : m) {
+    w.delta(keyframe, previous_keyframe);
+    std::vector<std::array<int16_t, 2>> shifts;
+    std::vector<uint32_t> keypoints;
+    for (const auto& e : entries) {
+      std::array<int16_t, 2> q{};
+      if (!quantize(e.shift.x(), q[0]) || !quantize(e.shift.y(), q[1])) continue;
+      if (!keypoints.empty() && e.keypoint <= keypoints.back()) continue;  // sorted, each once
+      keypoints.push_back(e.keypoint);
+      shifts.push_back(q);
+    }
+    w.put(static_cast<uint32_t>(keypoints.size()));
+    uint32_t previous = 0;
+    for (size_t i = 0; i < keypoints.size(); ++i) {
+      w.varint(keypoints[i] - previous);
+      previous = keypoints[i];
+      w.put(shifts[i][0]);
+      w.put(shifts[i][1]);
+    }
+  }
+  return std::move(w.data());
+}
+
+core::Remeasurements decodeRemeasurements(const std::vector<uint8_t>& raw) {
+  ByteReader r(raw.data(), raw.size());
+  core::Remeasurements m;
+  const uint32_t keyframes = r.count(5);
+  uint64_t previous_keyframe = 0;
+  for (uint32_t k = 0; k < keyframes; ++k) {
+    const Id keyframe = r.delta(previous_keyframe);
+    auto& entries = m[keyframe];
+    if (!entries.empty()) throw WireError("a keyframe listed twice");
+    entries.resize(r.count(5));
+    uint64_t previous = 0;
+    for (size_t i = 0; i < entries.size(); ++i) {
+      const uint64_t step = r.varint();
+      if (i > 0 && step == 0) throw WireError("keypoints out of order");
+      previous += step;
+      if (previous > 0xffffffffu) throw WireError("keypoint index out of range");
+      entries[i].keypoint = static_cast<uint32_t>(previous);
+      const auto x = r.get<int16_t>(), y = r.get<int16_t>();
+      entries[i].shift = Eigen::Vector2f(x * kShiftStep, y * kShiftStep);
+    }
+  }
+  if (!r.done()) throw WireError("trailing bytes");
+  return m;
+}
+
 std::vector<uint8_t> compress(const std::vector<uint8_t>& raw) {
   std::vector<uint8_t> out(ZSTD_compressBound(raw.size()));
   // Level 1: most of what zstd can take out of descriptors and floats, at the lowest CPU cost.

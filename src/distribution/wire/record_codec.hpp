@@ -5,11 +5,14 @@
 #include <cstdint>
 #include <vector>
 
+#include "core/optim/remeasurements.hpp"
 #include "distribution/wire/records.hpp"
 
 namespace hiveslam::distribution {
 
-enum class PacketKind : uint8_t { Keyframe = 1, Map = 2, Control = 3 };
+// Remeasured: observations TR measured again at the end of a run (core/optim/remeasurements.hpp),
+// TR -> LM -> LC ahead of the end-of-sequence packet, for the final global BA.
+enum class PacketKind : uint8_t { Keyframe = 1, Map = 2, Control = 3, Remeasured = 4 };
 // Control packets (the target field): sent in order with the keyframes or maps of their topic.
 enum class Control : uint8_t {
   EndOfSequence = 1,  // TR -> LM -> LC: no keyframe after this one
@@ -26,8 +29,11 @@ constexpr uint16_t kWireVersion = 2;
 
 std::vector<uint8_t> encode(const KeyFrameMessage& m);
 std::vector<uint8_t> encode(const MapRecord& m);
+// Shifts in steps of 1/256 pixel (a shift past 127 px is left out: no alignment moves that far).
+std::vector<uint8_t> encode(const core::Remeasurements& m);
 KeyFrameMessage decodeKeyframe(const std::vector<uint8_t>& raw);
 MapRecord decodeMap(const std::vector<uint8_t>& raw);
+core::Remeasurements decodeRemeasurements(const std::vector<uint8_t>& raw);
 
 std::vector<uint8_t> compress(const std::vector<uint8_t>& raw);
 // raw_size bounds the output (from the packet header, checked against a 256 MB ceiling).

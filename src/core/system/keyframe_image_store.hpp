@@ -1,0 +1,36 @@
+#pragma once
+// The grey images of the keyframes this node made, kept for the re-measurement of their
+// observations at the end of a run (optim/remeasure_observations.hpp): patch alignment needs the
+// very images the corners were found in, and only the node that tracked them has them (a
+// keyframe travels as features, never as an image).
+//
+// Level 0 only (361 KB at 752x480); the pyramids are built for the one pass that needs them and
+// released after it. Past the byte budget no more images are kept: those keyframes' observations
+// stay as detected.
+#include <mutex>
+#include <unordered_map>
+
+#include "core/features/image_pyramid.hpp"
+#include "core/map/ids.hpp"
+
+namespace hiveslam::core {
+
+class KeyframeImageStore {
+ public:
+  explicit KeyframeImageStore(size_t budget_bytes) : budget_(budget_bytes) {}
+  // Keeps a copy of `gray` (tracking thread, as the keyframe is made).
+  void keep(Id keyframe, const cv::Mat& gray);
+  bool empty() const;
+  size_t bytes() const;
+  // The pyramid of a kept image (null when none was kept), built on first use.
+  const features::ImagePyramid* pyramid(Id keyframe, int levels, double scale_factor);
+  void releasePyramids();
+
+ private:
+  mutable std::mutex mutex_;
+  size_t budget_, bytes_ = 0;
+  std::unordered_map<Id, cv::Mat> images_;
+  std::unordered_map<Id, features::ImagePyramid> pyramids_;
+};
+
+}  // namespace hiveslam::core
