@@ -69,7 +69,7 @@ void evalRemeasure(const std::shared_ptr<core::Map>& map, const std::string& dat
 
   core::BaProblem detected = whole.problem;
   const core::RemeasureStats stats = core::remeasureObservations(
-      whole, camera, [&](const core::KeyFrame& k) { return &images.at(&k); });
+      whole, camera, [&](const core::KeyFrame& k) { return std::shared_ptr<const features::ImagePyramid>(std::shared_ptr<void>(), &images.at(&k)); });
   fmt::print("map {}: {} keyframes, {} points, {} observations: {} anchors, {} measured again, {} kept as found; "
              "{} points with a plane from their neighbours\n",
              map->id, whole.keyframes.size(), whole.points.size(), whole.problem.observations.size(), stats.anchors,

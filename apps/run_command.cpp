@@ -37,7 +37,7 @@ nlohmann::json mappingStatsJson(const core::MappingStats& ms) {
 
 nlohmann::json remeasureJson(const core::SlamSystem::RemeasureReport& r) {
   return {{"measured_here", r.own},   {"anchors", r.stats.anchors}, {"kept_as_found", r.stats.kept},
-          {"points_on_a_plane", r.stats.plane_normals}, {"ms", r.ms}, {"image_mb", r.image_mb},
+          {"points_on_a_plane", r.stats.plane_normals}, {"ms", r.ms}, {"image_mb", r.image_mb}, {"pyramids_built", r.pyramids},
           {"used_by_final_ba", r.total}};
 }
 

@@ -98,7 +98,7 @@ TEST(RemeasureObservations, BringsTheLaterViewsOntoTheTrueProjections) {
   const BaProblem found = ba;
   Remeasurements measured;
   const RemeasureStats stats =
-      remeasureObservations(mp, cam, [&](const KeyFrame& k) { return &images.at(&k); }, {}, &measured);
+      remeasureObservations(mp, cam, [&](const KeyFrame& k) { return std::shared_ptr<const features::ImagePyramid>(std::shared_ptr<void>(), &images.at(&k)); }, {}, &measured);
   EXPECT_EQ(stats.anchors, ba.points.size());
   EXPECT_GT(stats.aligned, 0.9 * static_cast<double>(ba.observations.size() - ba.points.size()));
   EXPECT_GT(stats.plane_normals, 0.5 * static_cast<double>(ba.points.size()));

@@ -21,7 +21,15 @@ RemeasureStats remeasureObservations(MapBaProblem& mp, const camera::CameraModel
     int& a = anchor[static_cast<size_t>(ba.observations[o].point)];
     if (a < 0 || mp.sources[o].first->id < mp.sources[static_cast<size_t>(a)].first->id) a = static_cast<int>(o);
   }
-  for (size_t o = 0; o < ba.observations.size(); ++o) {
+  // Anchor by anchor (in keyframe order), and each anchor's views in keyframe order.
+  std::vector<size_t> order(ba.observations.size());
+  for (size_t o = 0; o < order.size(); ++o) order[o] = o;
+  const auto keyframe_of = [&](size_t o) { return mp.sources[o].first->id; };
+  const auto anchor_of = [&](size_t o) { return static_cast<size_t>(anchor[static_cast<size_t>(ba.observations[o].point)]); };
+  std::sort(order.begin(), order.end(), [&](size_t a, size_t b) {
+    return std::pair(keyframe_of(anchor_of(a)), keyframe_of(a)) < std::pair(keyframe_of(anchor_of(b)), keyframe_of(b));
+  });
+  for (const size_t o : order) {
     BaObservation& ob = ba.observations[o];
     const size_t point = static_cast<size_t>(ob.point);
     const size_t a = static_cast<size_t>(anchor[point]);
@@ -31,8 +39,8 @@ RemeasureStats remeasureObservations(MapBaProblem& mp, const camera::CameraModel
     }
     const KeyFrame& kf = *mp.sources[o].first;
     const KeyFrame& anchor_kf = *mp.sources[a].first;
-    const features::ImagePyramid* here = images(kf);
-    const features::ImagePyramid* there = images(anchor_kf);
+    const auto here = images(kf);
+    const auto there = images(anchor_kf);
     const cv::KeyPoint& kp = kf.frame.keypoints[static_cast<size_t>(mp.sources[o].second)];
     if (!here || !there || kp.octave >= here->levels()) {
       ++stats.kept;

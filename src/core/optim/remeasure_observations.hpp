@@ -11,6 +11,7 @@
 // (docs/BENCHMARKS.md, session 47). The plane comes from the point's neighbours
 // (map/point_normals.hpp); the fronto-parallel guess gains nothing.
 #include <functional>
+#include <memory>
 
 #include "core/camera/camera_model.hpp"
 #include "core/features/image_pyramid.hpp"
@@ -35,7 +36,10 @@ struct RemeasureStats {
 };
 
 // The grey image pyramid of a keyframe (null when it is not at hand: the observation is kept).
-using KeyframeImages = std::function<const features::ImagePyramid*(const KeyFrame&)>;
+// Shared, so that a cache may let it go while an alignment still reads it. The observations are
+// taken anchor by anchor, each anchor's in keyframe order: a cache of a few dozen pyramids serves
+// them (KeyframeImageStore).
+using KeyframeImages = std::function<std::shared_ptr<const features::ImagePyramid>(const KeyFrame&)>;
 
 // Replaces the `uv` of the observations of `mp` (buildMapBaProblem, with its poses and points)
 // by re-measured ones, and adds each to `measured` when given. The caller holds the map's mutex.

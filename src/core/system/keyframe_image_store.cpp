@@ -20,17 +20,30 @@ size_t KeyframeImageStore::bytes() const {
   return bytes_;
 }
 
-const features::ImagePyramid* KeyframeImageStore::pyramid(Id keyframe, int levels, double scale_factor) {
+std::shared_ptr<const features::ImagePyramid> KeyframeImageStore::pyramid(Id keyframe, int levels, double scale_factor) {
   std::lock_guard lock(mutex_);
-  if (const auto it = pyramids_.find(keyframe); it != pyramids_.end()) return &it->second;
+  for (auto it = pyramids_.begin(); it != pyramids_.end(); ++it)
+    if (it->first == keyframe) {
+      pyramids_.splice(pyramids_.begin(), pyramids_, it);
+      return it->second;
+    }
   const auto image = images_.find(keyframe);
   if (image == images_.end()) return nullptr;
-  return &pyramids_.emplace(keyframe, features::ImagePyramid(image->second, levels, scale_factor)).first->second;
+  auto p = std::make_shared<const features::ImagePyramid>(image->second, levels, scale_factor);
+  ++built_;
+  pyramids_.emplace_front(keyframe, p);
+  if (pyramids_.size() > cached_) pyramids_.pop_back();
+  return p;
 }
 
 void KeyframeImageStore::releasePyramids() {
   std::lock_guard lock(mutex_);
   pyramids_.clear();
+}
+
+size_t KeyframeImageStore::pyramidsBuilt() const {
+  std::lock_guard lock(mutex_);
+  return built_;
 }
 
 }  // namespace hiveslam::core

@@ -4,9 +4,12 @@
 // very images the corners were found in, and only the node that tracked them has them (a
 // keyframe travels as features, never as an image).
 //
-// Level 0 only (361 KB at 752x480); the pyramids are built for the one pass that needs them and
-// released after it. Past the byte budget no more images are kept: those keyframes' observations
-// stay as detected.
+// Level 0 only (361 KB at 752x480). The pyramids are built for the pass that needs them, the
+// latest few dozen kept (levels 1-7 hold 2.1 times level 0: all of sweep's together were 95 MB
+// more at the pass), and released after it. Past the byte budget no more images are kept: those
+// keyframes' observations stay as detected.
+#include <list>
+#include <memory>
 #include <mutex>
 #include <unordered_map>
 
@@ -17,20 +20,23 @@ namespace hiveslam::core {
 
 class KeyframeImageStore {
  public:
-  explicit KeyframeImageStore(size_t budget_bytes) : budget_(budget_bytes) {}
+  explicit KeyframeImageStore(size_t budget_bytes, size_t cached_pyramids = 48)
+      : budget_(budget_bytes), cached_(cached_pyramids) {}
   // Keeps a copy of `gray` (tracking thread, as the keyframe is made).
   void keep(Id keyframe, const cv::Mat& gray);
   bool empty() const;
   size_t bytes() const;
-  // The pyramid of a kept image (null when none was kept), built on first use.
-  const features::ImagePyramid* pyramid(Id keyframe, int levels, double scale_factor);
+  // The pyramid of a kept image (null when none was kept), built when not in the cache.
+  std::shared_ptr<const features::ImagePyramid> pyramid(Id keyframe, int levels, double scale_factor);
   void releasePyramids();
+  size_t pyramidsBuilt() const;
 
  private:
   mutable std::mutex mutex_;
-  size_t budget_, bytes_ = 0;
+  size_t budget_, cached_, bytes_ = 0, built_ = 0;
   std::unordered_map<Id, cv::Mat> images_;
-  std::unordered_map<Id, features::ImagePyramid> pyramids_;
+  // Most recently used first.
+  std::list<std::pair<Id, std::shared_ptr<const features::ImagePyramid>>> pyramids_;
 };
 
 }  // namespace hiveslam::core

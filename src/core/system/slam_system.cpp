@@ -214,6 +214,7 @@ SlamSystem::RemeasureReport SlamSystem::remeasureReport() const {
   std::lock_guard lock(remeasured_mutex_);
   RemeasureReport r = remeasure_report_;
   r.image_mb = static_cast<double>(images_.bytes()) / (1 << 20);
+  r.pyramids = images_.pyramidsBuilt();
   r.own = remeasurementCount(own_remeasured_);
   r.total = remeasurementCount(remeasured_);
   return r;

@@ -105,6 +105,7 @@ class SlamSystem {
     RemeasureStats stats;  // of the pass over this node's own keyframes
     double ms = 0;         // its time
     double image_mb = 0;   // keyframe images kept for it
+    size_t pyramids = 0;   // image pyramids it built (cached: a few dozen at a time)
     size_t own = 0;        // observations it measured again
     size_t total = 0;      // with those received
   };
