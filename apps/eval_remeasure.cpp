@@ -15,20 +15,10 @@ namespace hiveslam::apps {
 
 namespace {
 
-// The final global BA of a run (LoopCloser: sigma from the map's own median residual, an
-// outlier round), preceded by one at a pixel per level. Observations measured again start far
-// from the map's solution: judged at once against the tight noise, those that would pull the map
-// back into shape look like outliers and sit out (docs/BENCHMARKS.md, sessions 32 and 47).
+// The final global BA of a run, as the loop closer runs it on re-measured observations (loose
+// first, then sigma from the map's own median residual and an outlier round: core::solveGlobal).
 double finalBundleAdjustment(core::BaProblem& ba) {
-  core::BaOptions loose;
-  loose.iterations = 50;
-  loose.outliers = core::Outliers::Kept;
-  core::bundleAdjust(ba, loose);
-  const double sigma = core::setNoiseFromResiduals(ba, core::SlamSettings{}.global_ba_noise_factor);
-  core::BaOptions tight;
-  tight.iterations = 50;
-  tight.outliers = core::Outliers::SecondRound;
-  core::bundleAdjust(ba, tight);
+  const double sigma = core::solveGlobal(ba, 50, core::SlamSettings{}.global_ba_noise_factor, core::Outliers::SecondRound, true);
   return core::medianResidualSigma(ba) * sigma;  // in level pixels
 }
 

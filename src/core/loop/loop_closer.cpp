@@ -456,22 +456,12 @@ void LoopCloser::globalBundleAdjustment(Map& map, int iterations, bool corrected
   PoseCorrection correction;
   for (size_t i = 0; i < kfs.size(); ++i) correction.before[kfs[i]] = Sim3(ba.poses[i].q_cw, ba.poses[i].t_cw, 1.0);
   const std::vector<Eigen::Vector3d> centres = cameraCentres(ba);
-  BaOptions o;
-  o.iterations = iterations > 0 ? iterations : settings_.global_ba_iterations;
-  if (remeasured && applyRemeasurements(whole, *remeasured) > 0) {
-    BaOptions loose;
-    loose.iterations = o.iterations;
-    loose.outliers = Outliers::Kept;
-    bundleAdjust(ba, loose);
-  }
-  o.outliers = Outliers::Kept;
-  if (settings_.global_ba_noise_factor > 0) {
-    // Observations the map's own noise calls outliers sit this BA out; they stay in the map.
-    const double sigma = setNoiseFromResiduals(ba, settings_.global_ba_noise_factor);
-    o.outliers = settings_.global_ba_outliers_from_start && !corrected ? Outliers::FromStart : Outliers::SecondRound;
-    stats_.global_ba_sigma = sigma;
-  }
-  bundleAdjust(ba, o);
+  // Observations the map's own noise calls outliers sit this BA out; they stay in the map.
+  const bool loose_first = remeasured && applyRemeasurements(whole, *remeasured) > 0;
+  const Outliers outliers = settings_.global_ba_outliers_from_start && !corrected ? Outliers::FromStart : Outliers::SecondRound;
+  const double sigma = solveGlobal(ba, iterations > 0 ? iterations : settings_.global_ba_iterations,
+                                   settings_.global_ba_noise_factor, outliers, loose_first);
+  if (settings_.global_ba_noise_factor > 0) stats_.global_ba_sigma = sigma;
   const double restored = restoreScale(ba, centres);  // only the origin is fixed: the scale was free (scale_gauge.hpp)
   stats_.global_ba_scale_drift = std::max({stats_.global_ba_scale_drift, restored, 1.0 / restored});
   for (size_t i = 0; i < kfs.size(); ++i) correction.after[kfs[i]] = Sim3(ba.poses[i].q_cw, ba.poses[i].t_cw, 1.0);

@@ -147,4 +147,18 @@ double setNoiseFromResiduals(BaProblem& pb, double factor) {
   return sigma;
 }
 
+double solveGlobal(BaProblem& pb, int iterations, double noise_factor, Outliers outliers, bool loose_first) {
+  BaOptions o;
+  o.iterations = iterations;
+  o.outliers = Outliers::Kept;
+  if (loose_first) bundleAdjust(pb, o);
+  double sigma = 0;
+  if (noise_factor > 0) {
+    sigma = setNoiseFromResiduals(pb, noise_factor);
+    o.outliers = outliers;
+  }
+  bundleAdjust(pb, o);
+  return sigma;
+}
+
 }  // namespace hiveslam::core

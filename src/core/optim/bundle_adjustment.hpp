@@ -89,4 +89,12 @@ void setNoise(BaProblem& problem, double sigma);
 // call every rounding error an outlier). Returns the sigma set.
 double setNoiseFromResiduals(BaProblem& problem, double factor);
 
+// A global BA's solve. With `loose_first`, one solve at a pixel per level with nothing left out
+// goes first: observations measured again start far from the map's solution, and judged at once
+// against the tight noise, those that would pull the map into its new shape look like outliers
+// and sit out (docs/BENCHMARKS.md, session 47). Then, with noise_factor > 0, the noise is set
+// from the residuals (setNoiseFromResiduals) and `outliers` applies; without it, one solve with
+// every observation kept. Returns the sigma set (0 when none).
+double solveGlobal(BaProblem& problem, int iterations, double noise_factor, Outliers outliers, bool loose_first);
+
 }  // namespace hiveslam::core
