@@ -16,7 +16,9 @@ void KeyframeDatabase::erase(KeyFrame* kf) {
   if (!map_of_.erase(kf)) return;
   for (const auto& [w, x] : kf->bow) {
     auto it = index_.find(w);
-    if (it != index_.end()) it->second.remove(kf);
+    if (it == index_.end()) continue;
+    auto& list = it->second;
+    if (auto at = std::find(list.begin(), list.end(), kf); at != list.end()) list.erase(at);
   }
 }
 
