@@ -76,7 +76,8 @@ void serve(const NodeCommandOptions& o, communication::Task task) {
   report["loops"] = ls.loops;
   report["merges"] = ls.merges;
   report["global_bas"] = ls.global_bas;
-  report["remeasured"] = remeasureJson(slam.remeasureReport());
+  report["global_bas_discarded"] = ls.global_bas_discarded;  // the map moved while one ran: solved again later
+  report["remeasured"] = remeasureJson(slam.remeasureReport(), ls.remeasured);
   report["global_ba_sigma"] = ls.global_ba_sigma;  // 0 on a node that ran none
   report["global_ba_scale_drift"] = ls.global_ba_scale_drift;  // 1 on a node that ran none
   report["loop_events"] = loopEventsJson(ls);

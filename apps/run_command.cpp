@@ -35,10 +35,17 @@ nlohmann::json mappingStatsJson(const core::MappingStats& ms) {
           {"local_bas_cut_short", ms.local_bas_cut_short}};
 }
 
-nlohmann::json remeasureJson(const core::SlamSystem::RemeasureReport& r) {
-  return {{"measured_here", r.own},   {"anchors", r.stats.anchors}, {"kept_as_found", r.stats.kept},
-          {"points_on_a_plane", r.stats.plane_normals}, {"ms", r.ms}, {"image_mb", r.image_mb}, {"pyramids_built", r.pyramids},
-          {"used_by_final_ba", r.total}};
+nlohmann::json remeasureJson(const core::SlamSystem::RemeasureReport& r, const core::RemeasurementUse& use) {
+  return {{"measured_here", r.own},
+          {"anchors", r.stats.anchors},
+          {"kept_as_found", r.stats.kept},
+          {"points_on_a_plane", r.stats.plane_normals},
+          {"ms", r.ms},
+          {"image_mb", r.image_mb},
+          {"pyramids_built", r.pyramids},
+          {"held_for_final_ba", r.total},
+          {"final_ba", {{"applied", use.applied}, {"other_point", use.other_point}, {"other_anchor", use.other_anchor},
+                        {"not_measured", use.not_measured}}}};
 }
 
 nlohmann::json loopEventsJson(const core::LoopStats& stats) {
@@ -243,7 +250,7 @@ RunSummary runSlam(const RunOptions& o) {
   report["loops"] = ls.loops;
   report["merges"] = ls.merges;
   report["global_bas"] = ls.global_bas;
-  report["remeasured"] = remeasureJson(slam.remeasureReport());
+  report["remeasured"] = remeasureJson(slam.remeasureReport(), ls.remeasured);
   std::vector<eval::PlotEvent> plot_events;
   report["loop_events"] = loopEventsJson(ls);
   for (const auto& e : ls.events) plot_events.push_back({e.timestamp, e.kind == core::LoopEvent::Kind::Loop ? "loop" : "merge"});

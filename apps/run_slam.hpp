@@ -43,7 +43,7 @@ struct RunOptions {
 // recognized the place, matches, the Sim3's scale (the drift seen), timings.
 nlohmann::json loopEventsJson(const core::LoopStats& stats);
 // The re-measurement of observations before the final global BA (SlamSettings::remeasure).
-nlohmann::json remeasureJson(const core::SlamSystem::RemeasureReport& r);
+nlohmann::json remeasureJson(const core::SlamSystem::RemeasureReport& r, const core::RemeasurementUse& use);
 // Local mapping's counts (keyframes processed and culled, points made and culled, local BAs).
 nlohmann::json mappingStatsJson(const core::MappingStats& stats);
 

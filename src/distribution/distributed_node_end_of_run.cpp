@@ -86,11 +86,14 @@ void DistributedNode::onControl(const Message& m, Topic topic) {
 }
 
 void DistributedNode::pushRemeasurements(const core::Remeasurements& r, Topic topic) {
-  // A few packets of at most 20 keyframes (a sweep run: some 28,000 observations, 150 KB).
+  // A few packets of at most 20 keyframes (a sweep run: some 29,600 observations, 246 KB).
   constexpr size_t kKeyframesPerPacket = 20;
   core::Remeasurements part;
+  size_t bytes = 0, packets = 0;
   const auto send = [&] {
     auto m = std::make_shared<Message>(pack(part, options_.id, 0, 0, 0));
+    bytes += m->wireSize();
+    ++packets;
     publisher_->push({nullptr, nullptr, topic, 0, false, std::move(m)});
     part.clear();
   };
@@ -99,6 +102,8 @@ void DistributedNode::pushRemeasurements(const core::Remeasurements& r, Topic to
     if (part.size() == kKeyframesPerPacket) send();
   }
   if (!part.empty()) send();
+  spdlog::info("node {}: {} re-measured observations sent in {} packets, {} KB", options_.id, core::remeasurementCount(r),
+               packets, bytes / 1024);
 }
 
 bool DistributedNode::finishAsGateway() {

@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <map>
+#include <set>
 #include <opencv2/imgproc.hpp>
 
 #include "core/camera/pinhole_radtan.hpp"
@@ -44,6 +45,8 @@ TEST(RemeasureObservations, BringsTheLaterViewsOntoTheTrueProjections) {
     ba.poses.push_back({Eigen::Quaterniond(k->T_cw.linear()), k->T_cw.translation(), false});
   }
   const Frame& first = kfs[0]->frame;
+  std::vector<std::shared_ptr<MapPoint>> map_points;
+  std::vector<std::set<int>> taken(kfs.size());  // a keypoint observes one point, as in a map
   for (size_t i = 0; i < first.size(); ++i) {
     const cv::Point2f p = first.keypoints[i].pt;
     const int level = first.keypoints[i].octave;
@@ -59,18 +62,21 @@ TEST(RemeasureObservations, BringsTheLaterViewsOntoTheTrueProjections) {
       int partner = -1;
       for (size_t j = 0; j < f.size(); ++j) {
         const double r = (f.points[j] - truth).norm();
-        if (f.keypoints[j].octave != level || r >= best ||
+        if (f.keypoints[j].octave != level || r >= best || taken[v].count(static_cast<int>(j)) ||
             features::hamming(first.descriptors.ptr<uchar>(static_cast<int>(i)), f.descriptors.ptr<uchar>(static_cast<int>(j))) > 50)
           continue;
         best = r;
         partner = static_cast<int>(j);
       }
       partners.push_back(partner);
+      if (partner >= 0) taken[v].insert(partner);
     }
     // Every corner of the first view becomes a point, seen by whichever later view found it: the
     // points around each one give its plane.
     const int point = static_cast<int>(ba.points.size());
     ba.points.push_back({X, false});
+    map_points.push_back(std::make_shared<MapPoint>(100 + ba.points.size(), X, kfs[0]->id));
+    mp.points.push_back(map_points.back().get());
     for (size_t v = 0; v < kfs.size(); ++v) {
       if (partners[v] < 0) continue;
       const size_t j = static_cast<size_t>(partners[v]);
@@ -115,9 +121,35 @@ TEST(RemeasureObservations, BringsTheLaterViewsOntoTheTrueProjections) {
   EXPECT_EQ(remeasurementCount(measured), stats.aligned);
   MapBaProblem again = mp;
   again.problem.observations = found.observations;
-  EXPECT_EQ(applyRemeasurements(again, measured), stats.aligned);
+  const RemeasurementUse use = applyRemeasurements(again, measured);
+  EXPECT_EQ(use.applied, stats.aligned);
+  EXPECT_EQ(use.not_measured, stats.kept);
+  EXPECT_EQ(use.other_point + use.other_anchor, 0u);
   for (size_t i = 0; i < moved.size(); ++i)
     EXPECT_LT((again.problem.observations[i].uv - mp.problem.observations[i].uv).norm(), 1e-4) << i;
+
+  // Where the map that applies them has changed since (a keypoint now another point's, a point
+  // with an earlier observer), those shifts are left out: each would move its observation onto
+  // a texture location its point's other observations do not share.
+  MapBaProblem changed = mp;
+  changed.problem.observations = found.observations;
+  // Two points whose two later views were both measured again.
+  std::vector<size_t> both;
+  for (size_t p = 0; p < changed.points.size() && both.size() < 2; ++p) {
+    size_t measured_views = 0;
+    for (size_t o = 0; o < moved.size(); ++o) measured_views += static_cast<size_t>(changed.problem.observations[o].point) == p && moved[o];
+    if (measured_views == 2) both.push_back(p);
+  }
+  ASSERT_EQ(both.size(), 2u);
+  const auto fused = std::make_shared<MapPoint>(99, changed.points[both[0]]->position, kfs[0]->id);
+  changed.points[both[0]] = fused.get();  // fused into another point
+  for (size_t o = 0; o < changed.sources.size(); ++o)  // anchored by another corner of the first keyframe
+    if (static_cast<size_t>(changed.problem.observations[o].point) == both[1] && changed.sources[o].first == kfs[0].get())
+      changed.sources[o].second += 1;
+  const RemeasurementUse partial = applyRemeasurements(changed, measured);
+  EXPECT_EQ(partial.other_point, 2u);
+  EXPECT_EQ(partial.other_anchor, 2u);
+  EXPECT_EQ(partial.applied, stats.aligned - 4);
 }
 
 }  // namespace

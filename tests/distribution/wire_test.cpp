@@ -95,17 +95,22 @@ TEST(Wire, MalformedBodiesAreRejected) {
 
 TEST(Wire, RemeasurementsRoundTripInSteps) {
   core::Remeasurements r;
-  r[42] = {{3, {0.25f, -0.125f}}, {17, {1.0f / 512, 2.0f}}, {900, {-100.0f, 0.0f}}};
-  r[7] = {{0, {0.0f, 0.01f}}};
-  r[8] = {{5, {400.0f, 0.0f}}};  // farther than any alignment moves: left out
+  r[42] = {{3, {0.25f, -0.125f}, 1000, 40, 7}, {17, {1.0f / 512, 2.0f}, 5, 42, 17}, {900, {-100.0f, 0.0f}, 123456789, 0, 4000}};
+  r[7] = {{0, {0.0f, 0.01f}, 0, 3, 0}};
+  r[8] = {{5, {400.0f, 0.0f}, 9, 1, 1}};  // farther than any alignment moves: left out
+  r[9] = {{5, {1.0f, 0.0f}, 9, 10, 1}};   // an anchor after its keyframe: left out
   const auto packet = pack(r, 1, 0, 0, 0);
   EXPECT_EQ(packet.kind, static_cast<uint8_t>(PacketKind::Remeasured));
   const core::Remeasurements back = decodeRemeasurements(unpack(packet, PacketKind::Remeasured));
-  ASSERT_EQ(back.size(), 3u);
+  ASSERT_EQ(back.size(), 4u);
   EXPECT_TRUE(back.at(8).empty());
+  EXPECT_TRUE(back.at(9).empty());
   ASSERT_EQ(back.at(42).size(), 3u);
   for (size_t i = 0; i < 3; ++i) {
     EXPECT_EQ(back.at(42)[i].keypoint, r[42][i].keypoint);
+    EXPECT_EQ(back.at(42)[i].point, r[42][i].point);
+    EXPECT_EQ(back.at(42)[i].anchor_keyframe, r[42][i].anchor_keyframe);
+    EXPECT_EQ(back.at(42)[i].anchor_keypoint, r[42][i].anchor_keypoint);
     EXPECT_NEAR(back.at(42)[i].shift.x(), r[42][i].shift.x(), 1.0 / 512);
     EXPECT_NEAR(back.at(42)[i].shift.y(), r[42][i].shift.y(), 1.0 / 512);
   }
@@ -124,8 +129,22 @@ TEST(Wire, RemeasurementsRoundTripInSteps) {
     w.varint(i == 0 ? 5 : 0);  // the second one repeats keypoint 5
     w.put(int16_t{1});
     w.put(int16_t{1});
+    w.varint(3);  // point
+    w.varint(1);  // anchor: one keyframe back
+    w.varint(2);  // anchor keypoint
   }
   EXPECT_THROW(decodeRemeasurements(w.data()), WireError);
+  ByteWriter early;
+  early.put(uint32_t{1});
+  early.varint(10);
+  early.put(uint32_t{1});
+  early.varint(5);
+  early.put(int16_t{1});
+  early.put(int16_t{1});
+  early.varint(3);
+  early.varint(11);  // an anchor before keyframe 0
+  early.varint(2);
+  EXPECT_THROW(decodeRemeasurements(early.data()), WireError);
 }
 
 TEST(Policy, TrackingFollowsThePapersFourCases) {

@@ -439,7 +439,7 @@ void LoopCloser::optimizeEssentialGraph(Map& map, const LoopCorrection& c, LoopE
   event.essential_graph_ms = msSince(t0);
 }
 
-void LoopCloser::globalBundleAdjustment(Map& map, int iterations, bool corrected, const Remeasurements* remeasured) {
+bool LoopCloser::globalBundleAdjustment(Map& map, int iterations, bool corrected, const Remeasurements* remeasured) {
   const auto t0 = std::chrono::steady_clock::now();
   MapBaProblem whole;
   uint64_t epoch = 0;
@@ -452,12 +452,16 @@ void LoopCloser::globalBundleAdjustment(Map& map, int iterations, bool corrected
   const std::vector<KeyFrame*>& kfs = whole.keyframes;
   const std::vector<MapPoint*>& pts = whole.points;
   BaProblem& ba = whole.problem;
-  if (kfs.size() < 3) return;
+  if (kfs.size() < 3) return true;
   PoseCorrection correction;
   for (size_t i = 0; i < kfs.size(); ++i) correction.before[kfs[i]] = Sim3(ba.poses[i].q_cw, ba.poses[i].t_cw, 1.0);
   const std::vector<Eigen::Vector3d> centres = cameraCentres(ba);
   // Observations the map's own noise calls outliers sit this BA out; they stay in the map.
-  const bool loose_first = remeasured && applyRemeasurements(whole, *remeasured) > 0;
+  bool loose_first = false;
+  if (remeasured) {
+    stats_.remeasured = applyRemeasurements(whole, *remeasured);
+    loose_first = stats_.remeasured.applied > 0;
+  }
   const Outliers outliers = settings_.global_ba_outliers_from_start && !corrected ? Outliers::FromStart : Outliers::SecondRound;
   const double sigma = solveGlobal(ba, iterations > 0 ? iterations : settings_.global_ba_iterations,
                                    settings_.global_ba_noise_factor, outliers, loose_first);
@@ -470,7 +474,7 @@ void LoopCloser::globalBundleAdjustment(Map& map, int iterations, bool corrected
     std::lock_guard lock(map.mutex);
     if (map.epoch != epoch || map.merged_into.load()) {
       ++stats_.global_bas_discarded;
-      return;
+      return false;
     }
     applyCorrection(map, correction, scales_);
   }
@@ -479,6 +483,7 @@ void LoopCloser::globalBundleAdjustment(Map& map, int iterations, bool corrected
   const double ms = msSince(t0);
   stats_.global_ba_ms_total += ms;
   stats_.global_ba_ms.emplace_back(static_cast<int>(kfs.size()), ms);
+  return true;
 }
 
 void LoopCloser::mergeMaps(Map& map, KeyFrame& kf, Map& other, const Verified& v) {

@@ -45,6 +45,7 @@ struct LoopStats {
   double query_ms_total = 0, global_ba_ms_total = 0;
   double global_ba_sigma = 0;  // the noise the last global BA judged residuals by, in level sigmas
   double global_ba_scale_drift = 1;  // the largest scale change a global BA made and had taken back (>= 1)
+  RemeasurementUse remeasured;       // how the last global BA given re-measured observations used them
   std::vector<LoopEvent> events;
   std::vector<std::pair<int, double>> global_ba_ms;  // (keyframes, ms) per global BA
 };
@@ -77,7 +78,9 @@ class LoopCloser {
   // the map's tight noise, the observations that would pull the map into its new shape look
   // like outliers and sit out: the map stayed at its old scale step (docs/BENCHMARKS.md,
   // session 47).
-  void globalBundleAdjustment(Map& map, int iterations = 0, bool corrected = false,
+  // Returns false when the map moved while it ran (a node applied a global map meanwhile):
+  // nothing was applied, and the caller may solve again.
+  bool globalBundleAdjustment(Map& map, int iterations = 0, bool corrected = false,
                               const Remeasurements* remeasured = nullptr);
 
  private:

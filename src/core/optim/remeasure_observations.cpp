@@ -15,12 +15,7 @@ RemeasureStats remeasureObservations(MapBaProblem& mp, const camera::CameraModel
   std::vector<Eigen::Vector3d> positions;
   for (const BaPoint& p : ba.points) positions.push_back(p.p_w);
   const auto normals = planeNormals(positions, options.normals);
-  // Each point's anchor: its observation in the earliest keyframe (the lowest id).
-  std::vector<int> anchor(ba.points.size(), -1);
-  for (size_t o = 0; o < ba.observations.size(); ++o) {
-    int& a = anchor[static_cast<size_t>(ba.observations[o].point)];
-    if (a < 0 || mp.sources[o].first->id < mp.sources[static_cast<size_t>(a)].first->id) a = static_cast<int>(o);
-  }
+  const std::vector<int> anchor = pointAnchors(mp);
   // Anchor by anchor (in keyframe order), and each anchor's views in keyframe order.
   std::vector<size_t> order(ba.observations.size());
   for (size_t o = 0; o < order.size(); ++o) order[o] = o;
@@ -74,7 +69,8 @@ RemeasureStats remeasureObservations(MapBaProblem& mp, const camera::CameraModel
     ++stats.aligned;
     if (measured) {
       const auto idx = static_cast<size_t>(mp.sources[o].second);
-      (*measured)[kf.id].push_back({static_cast<uint32_t>(idx), (ob.uv - kf.frame.points[idx]).cast<float>()});
+      (*measured)[kf.id].push_back({static_cast<uint32_t>(idx), (ob.uv - kf.frame.points[idx]).cast<float>(), mp.points[point]->id,
+                                    anchor_kf.id, static_cast<uint32_t>(mp.sources[a].second)});
     }
   }
   for (const auto& n : normals) stats.plane_normals += n.has_value();

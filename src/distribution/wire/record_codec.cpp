@@ -279,22 +279,25 @@ std::vector<uint8_t> encode(const core::Remeasurements& m) {
   uint64_t previous_keyframe = 0;
   for (const auto& [keyframe, entries] : m) {
     w.delta(keyframe, previous_keyframe);
-    std::vector<std::array<int16_t, 2>> shifts;
-    std::vector<uint32_t> keypoints;
+    // Sorted, each keypoint once, the anchor no later than the keyframe: what decoding checks.
+    std::vector<std::pair<const core::Remeasurement*, std::array<int16_t, 2>>> kept;
     for (const auto& e : entries) {
       std::array<int16_t, 2> q{};
       if (!quantize(e.shift.x(), q[0]) || !quantize(e.shift.y(), q[1])) continue;
-      if (!keypoints.empty() && e.keypoint <= keypoints.back()) continue;  // sorted, each once
-      keypoints.push_back(e.keypoint);
-      shifts.push_back(q);
+      if (!kept.empty() && e.keypoint <= kept.back().first->keypoint) continue;
+      if (e.point == core::kNoId || e.anchor_keyframe > keyframe) continue;
+      kept.emplace_back(&e, q);
     }
-    w.put(static_cast<uint32_t>(keypoints.size()));
+    w.put(static_cast<uint32_t>(kept.size()));
     uint32_t previous = 0;
-    for (size_t i = 0; i < keypoints.size(); ++i) {
-      w.varint(keypoints[i] - previous);
-      previous = keypoints[i];
-      w.put(shifts[i][0]);
-      w.put(shifts[i][1]);
+    for (const auto& [e, q] : kept) {
+      w.varint(e->keypoint - previous);
+      previous = e->keypoint;
+      w.put(q[0]);
+      w.put(q[1]);
+      w.varint(e->point);
+      w.varint(keyframe - e->anchor_keyframe);
+      w.varint(e->anchor_keypoint);
     }
   }
   return std::move(w.data());
@@ -319,6 +322,13 @@ core::Remeasurements decodeRemeasurements(const std::vector<uint8_t>& raw) {
       entries[i].keypoint = static_cast<uint32_t>(previous);
       const auto x = r.get<int16_t>(), y = r.get<int16_t>();
       entries[i].shift = Eigen::Vector2f(x * kShiftStep, y * kShiftStep);
+      entries[i].point = r.varint();
+      const uint64_t back = r.varint();
+      if (back > keyframe) throw WireError("anchor keyframe out of range");
+      entries[i].anchor_keyframe = keyframe - back;
+      const uint64_t anchor_keypoint = r.varint();
+      if (anchor_keypoint > 0xffffffffu) throw WireError("keypoint index out of range");
+      entries[i].anchor_keypoint = static_cast<uint32_t>(anchor_keypoint);
     }
   }
   if (!r.done()) throw WireError("trailing bytes");

@@ -25,11 +25,13 @@ enum class Control : uint8_t {
 };
 // Raised with every change of the encoding, so that a node of another build drops what it
 // cannot read with a warning instead of misreading it. 2: map records carry `update`.
-constexpr uint16_t kWireVersion = 2;
+// 3: re-measured observations name their point and its anchor.
+constexpr uint16_t kWireVersion = 3;
 
 std::vector<uint8_t> encode(const KeyFrameMessage& m);
 std::vector<uint8_t> encode(const MapRecord& m);
-// Shifts in steps of 1/256 pixel (a shift past 127 px is left out: no alignment moves that far).
+// Shifts in steps of 1/256 pixel (a shift past 127 px is left out: no alignment moves that far),
+// each with its point's id and anchor (keyframe back from this one, keypoint) as varints.
 std::vector<uint8_t> encode(const core::Remeasurements& m);
 KeyFrameMessage decodeKeyframe(const std::vector<uint8_t>& raw);
 MapRecord decodeMap(const std::vector<uint8_t>& raw);
