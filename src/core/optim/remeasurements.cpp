@@ -56,6 +56,7 @@ RemeasurementUse applyRemeasurements(MapBaProblem& mp, const Remeasurements& r) 
   }
   return use;
 }
+
 size_t remeasurementCount(const Remeasurements& r) {
   size_t n = 0;
   for (const auto& [keyframe, entries] : r) n += entries.size();
