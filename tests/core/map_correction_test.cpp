@@ -4,6 +4,7 @@
 // culled keyframe.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 
 #include "core/loop/map_correction.hpp"
@@ -202,6 +203,52 @@ TEST(MapCorrection, AMergedMapsRootLeftOutOfARigidCorrectionMovesWithItsNeighbou
 
 TEST(MapCorrection, AMergedMapsRootLeftOutOfASimilarityCorrectionMovesWithItsNeighbours) {
   aRootLeftOutOfTheCorrectionMovesWithItsNeighbours(false);
+}
+
+
+// A point whose last observer was culled has nothing to follow a correction by. Left where it
+// was, it stayed in the old frame (blackout's 3-node runs ended with dozens such points, some
+// behind the frames that had tracked them); it leaves the map, and the erasure is journalled for
+// the other nodes. A point the correction places (a global BA's) stays, observed or not.
+TEST(MapCorrection, APointNoKeyframeSeesLeavesTheMapAtACorrection) {
+  Corridor c;
+  c.map.journal_on = true;
+  // The last point (x = 2.57) is seen by the last keyframe only.
+  MapPoint* lonely = c.points.back().get();
+  ASSERT_EQ(lonely->observations.size(), 1u);
+  KeyFrame* only = lonely->observations.begin()->first;
+  ASSERT_NE(only, c.map.origin);
+  c.map.erase(*only);
+  ASSERT_TRUE(lonely->observations.empty());
+  // Point 1 is unseen too but placed by the correction.
+  MapPoint* placed = c.points[1].get();
+  for (auto [kf, i] : std::vector<std::pair<KeyFrame*, int>>(placed->observations.begin(), placed->observations.end())) {
+    kf->points[static_cast<size_t>(i)].reset();
+    placed->observations.erase(kf);
+  }
+  ASSERT_TRUE(placed->observations.empty());
+  std::vector<Id> unseen;  // the lonely point among them: the last keyframe saw a few alone
+  for (const auto& p : c.points)
+    if (p->observations.empty() && p.get() != placed) unseen.push_back(p->id);
+  const Eigen::Vector3d seen_before = c.points[60]->position;
+
+  const Sim3 S = someSimilarity();
+  PoseCorrection correction;
+  for (const auto& [id, kf] : c.map.keyframes) {
+    correction.before[kf.get()] = Sim3(kf->T_cw);
+    correction.after[kf.get()] = Sim3(kf->T_cw) * S.inverse();
+  }
+  correction.points[placed] = S * placed->position;
+  applyCorrection(c.map, correction, {1.0});
+
+  EXPECT_TRUE(lonely->bad);
+  EXPECT_EQ(c.map.points.count(lonely->id), 0u);
+  std::vector<Id> erased = c.map.journal.erased_points;
+  std::sort(erased.begin(), erased.end());
+  EXPECT_EQ(erased, unseen);
+  EXPECT_FALSE(placed->bad);
+  EXPECT_EQ(c.map.points.count(placed->id), 1u);
+  EXPECT_LT((c.points[60]->position - S * seen_before).norm(), 1e-9);
 }
 
 }  // namespace

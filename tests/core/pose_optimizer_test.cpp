@@ -7,7 +7,8 @@
 namespace hiveslam::core {
 namespace {
 
-TEST(PoseOptimizer, RecoversPoseAndRejectsInjectedOutliers) {
+// Under either loss: tracking's Huber and the end-of-run refinement's Cauchy.
+void recoversPoseAndRejectsInjectedOutliers(const PoseLoss& loss) {
   std::mt19937 rng(7);
   std::uniform_real_distribution<double> u(-1, 1);
   std::normal_distribution<double> n(0, 0.7);
@@ -29,7 +30,7 @@ TEST(PoseOptimizer, RecoversPoseAndRejectsInjectedOutliers) {
   T.translation() += Eigen::Vector3d(0.08, 0.05, -0.06);
   T.linear() = T.linear() * Eigen::AngleAxisd(0.05, Eigen::Vector3d::UnitX()).toRotationMatrix();
   std::vector<bool> outlier;
-  const int inliers = optimizePose(K, obs, T, outlier);
+  const int inliers = optimizePose(K, obs, T, outlier, loss);
   EXPECT_LT((T.translation() - truth.translation()).norm(), 0.01);
   EXPECT_LT(Eigen::AngleAxisd(T.linear().transpose() * truth.linear()).angle(), 0.003);
   int caught = 0, false_alarms = 0;
@@ -40,6 +41,12 @@ TEST(PoseOptimizer, RecoversPoseAndRejectsInjectedOutliers) {
   EXPECT_EQ(caught, 40);
   EXPECT_LE(false_alarms, 8);
   EXPECT_EQ(inliers, static_cast<int>(obs.size()) - caught - false_alarms);
+}
+
+TEST(PoseOptimizer, RecoversPoseAndRejectsInjectedOutliersUnderHuber) { recoversPoseAndRejectsInjectedOutliers({}); }
+
+TEST(PoseOptimizer, RecoversPoseAndRejectsInjectedOutliersUnderCauchy) {
+  recoversPoseAndRejectsInjectedOutliers(PoseLoss::cauchy());
 }
 
 }  // namespace

@@ -6,8 +6,9 @@
 // of their anchor; the root of a map merged into this one: of its strongest neighbour). Rigid
 // poses that come with moved points get the scale change their points show. Each keyframe's
 // scale_change takes its correction's scale, so culled keyframes and tracked frames, held
-// relative to live keyframes (KeyFrame::pose), follow it exactly. The caller holds the map's
-// mutex.
+// relative to live keyframes (KeyFrame::pose), follow it exactly. A point that no keyframe
+// sees and the correction does not place has nothing to follow: it is erased. The caller holds
+// the map's mutex.
 #include <unordered_map>
 
 #include "core/geometry/sim3.hpp"

@@ -40,11 +40,10 @@ double chi2Of(const Intrinsics& K, const PoseObservation& o, const Eigen::Isomet
   return ((K.project(pc) - o.uv) * o.inv_sigma).squaredNorm();
 }
 
-// One Gauss-Newton (IRLS) solve over the observations not flagged as outliers. With
-// `robust`, residuals beyond the Huber threshold are down-weighted, as Ceres' HuberLoss would.
+// One Gauss-Newton (IRLS) solve over the observations not flagged as outliers. With `robust`,
+// large residuals are down-weighted by `loss`, as Ceres' HuberLoss or CauchyLoss would.
 void solve(const Intrinsics& K, const std::vector<PoseObservation>& obs, const std::vector<bool>& outlier,
-           bool robust, Eigen::Isometry3d& T) {
-  const double delta = std::sqrt(kChi2);
+           const PoseLoss* robust, Eigen::Isometry3d& T) {
   double last_cost = std::numeric_limits<double>::infinity();
   Eigen::Isometry3d last_T = T;
   for (int it = 0; it < kIterations; ++it) {
@@ -58,8 +57,17 @@ void solve(const Intrinsics& K, const std::vector<PoseObservation>& obs, const s
       const double iz = 1.0 / pc.z();
       const Eigen::Vector2d r = (K.project(pc) - obs[i].uv) * obs[i].inv_sigma;
       const double e = r.norm();
-      const double w = robust && e > delta ? delta / e : 1.0;
-      cost += robust && e > delta ? 2 * delta * e - delta * delta : e * e;
+      double w = 1.0;
+      if (!robust) {
+        cost += e * e;
+      } else if (const double c = robust->scale; robust->kind == PoseLoss::Kind::Huber) {
+        w = e > c ? c / e : 1.0;
+        cost += e > c ? 2 * c * e - c * c : e * e;
+      } else {
+        const double u = e * e / (c * c);
+        w = 1.0 / (1.0 + u);
+        cost += c * c * std::log1p(u);
+      }
       Eigen::Matrix<double, 2, 3> Jp;
       Jp << K.fx * iz, 0, -K.fx * pc.x() * iz * iz, 0, K.fy * iz, -K.fy * pc.y() * iz * iz;
       Jp *= obs[i].inv_sigma;
@@ -87,14 +95,14 @@ void solve(const Intrinsics& K, const std::vector<PoseObservation>& obs, const s
 }  // namespace
 
 int optimizePose(const Intrinsics& K, const std::vector<PoseObservation>& obs, Eigen::Isometry3d& T_cw,
-                 std::vector<bool>& outlier) {
+                 std::vector<bool>& outlier, const PoseLoss& loss) {
   outlier.assign(obs.size(), false);
   if (obs.size() < 3) return 0;
   int inliers = 0;
   for (int round = 0; round < kRounds; ++round) {
     // The last round runs without the robust kernel, on inliers only.
     const Eigen::Isometry3d before = T_cw;
-    solve(K, obs, outlier, round < kRounds - 1, T_cw);
+    solve(K, obs, outlier, round < kRounds - 1 ? &loss : nullptr, T_cw);
     inliers = 0;
     for (size_t i = 0; i < obs.size(); ++i) {
       // Every round re-classifies all observations: an early outlier may come back.

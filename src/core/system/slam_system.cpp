@@ -343,14 +343,17 @@ int SlamSystem::refineFrames() {
       std::lock_guard lock(map->mutex);
       for (const auto& o : r.observations) {
         const auto it = map->points.find(o.point);
-        if (it == map->points.end() || it->second->bad) continue;
+        // A point no keyframe sees is no longer kept by any optimization (and may not have
+        // followed the map's last correction): not part of the final map.
+        if (it == map->points.end() || it->second->bad || it->second->observations.empty()) continue;
         obs.push_back({it->second->position, o.uv.cast<double>(), 1.0 / scales[o.octave]});
       }
       T_cw = r.reference->poseOf(r.T_c_ref);
     }
     if (obs.size() < kMinMatches) continue;
     std::vector<bool> outlier;
-    if (optimizePose(K, obs, T_cw, outlier) < static_cast<int>(kMinMatches)) continue;
+    // Cauchy: a frame mostly on one wall is pulled less by a few near points slightly off.
+    if (optimizePose(K, obs, T_cw, outlier, PoseLoss::cauchy()) < static_cast<int>(kMinMatches)) continue;
     std::lock_guard lock(map->mutex);
     r.T_c_ref = r.reference->relative(T_cw);
     ++refined;
