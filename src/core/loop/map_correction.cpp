@@ -118,10 +118,10 @@ void applyCorrection(Map& map, const PoseCorrection& c, const std::vector<double
     }
   }
   // A point no keyframe sees any more (its last observer culled, or relinked away by an update)
-  // has nothing to move it by. Left where it was it stays in the old frame: in blackout's
-  // 3-node runs some 40-70 such points ended up to 2 map units behind the frames that had
-  // tracked them, and one 0.03 map units (some 9 cm) in front of a frame pulled that frame's end-of-run
-  // refinement 13 mm off. It leaves the map (journalled, so the other nodes drop it too).
+  // has nothing to move it by. Left where it was it stays in the old frame: blackout's 3-node
+  // runs ended with some 40-70 such points, many up to 2 map units behind the frames that had
+  // tracked them, and one 0.03 map units (some 9 cm) in front of a frame pulled that frame's
+  // end-of-run refinement 13 mm off. It leaves the map (journalled: the other nodes drop it too).
   for (MapPoint* p : unseen) map.erase(*p);
   for (const auto& [kf, after] : c.after)
     if (!kf->bad) {
