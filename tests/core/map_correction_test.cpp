@@ -205,7 +205,6 @@ TEST(MapCorrection, AMergedMapsRootLeftOutOfASimilarityCorrectionMovesWithItsNei
   aRootLeftOutOfTheCorrectionMovesWithItsNeighbours(false);
 }
 
-
 // A point whose last observer was culled has nothing to follow a correction by. Left where it
 // was, it stayed in the old frame (blackout's 3-node runs ended with dozens such points, some
 // behind the frames that had tracked them); it leaves the map, and the erasure is journalled for
