@@ -142,7 +142,7 @@ void setNoise(BaProblem& pb, double sigma) {
 }
 
 double setNoiseFromResiduals(BaProblem& pb, double factor) {
-  const double sigma = std::clamp(factor * medianResidualSigma(pb), 0.02, 1.0);
+  const double sigma = std::clamp(factor * medianResidualSigma(pb), 0.1, 1.0);
   setNoise(pb, sigma);
   return sigma;
 }

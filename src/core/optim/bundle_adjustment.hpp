@@ -84,12 +84,9 @@ double medianResidualSigma(const BaProblem& problem);
 // measurements are more precise than one pixel per level), so that the Huber kernel and the
 // chi-square test of the outlier round judge residuals against the noise the map really has.
 void setNoise(BaProblem& problem, double sigma);
-// setNoise with `factor` times the noise medianResidualSigma reads, clamped to 0.02-1 px per level
-// (a fiftieth of a pixel at the least: a map fitted exactly, a test's noiseless one, would otherwise
-// call every rounding error an outlier). Patch-aligned observations measure to about 0.04 px per
-// level: a floor of 0.1 judged them against two and a half times their noise (nine sequential
-// sweep maps, the final BA of the re-measured map: keyframe ATE median 0.89 -> 0.78 mm, max
-// 1.34 -> 1.19, eight of nine better; docs/BENCHMARKS.md, session 53). Returns the sigma set.
+// setNoise with `factor` times the noise medianResidualSigma reads, clamped to 0.1-1 px per level
+// (a tenth of a pixel at the least: a map fitted exactly, a test's noiseless one, would otherwise
+// call every rounding error an outlier). Returns the sigma set.
 double setNoiseFromResiduals(BaProblem& problem, double factor);
 
 // A global BA's solve. With `loose_first`, one solve at a pixel per level with nothing left out
