@@ -274,7 +274,12 @@ const FrameRecord& SlamSystem::process(const cv::Mat& gray, double timestamp) {
                            : mode_ == Mode::Sequential || (!mapping_busy_ && jobs_.size() == 0);
   TrackingOutput out = tracker_.track(makeFrame(gray, r.index, timestamp, extractor_, *camera_), idle);
   r.tracking_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  if (settings_.remeasure && out.initialization_reference) initialization_image_ = gray.clone();
   if (out.new_map) {
+    // Its first keyframe anchors every point of the initial map: without its image none of their
+    // observations could be measured again (2,400 of sweep's 34,500 were kept as found).
+    if (settings_.remeasure && !initialization_image_.empty()) images_.keep(out.new_map->origin->id, initialization_image_);
+    initialization_image_.release();
     addMap(out.new_map);
     active_map_ = out.new_map.get();
     if (events_) events_->mapCreated(out.new_map);

@@ -156,6 +156,9 @@ class SlamSystem {
   std::atomic<int> loop_jobs_pending_{0};
   std::atomic<bool> final_ba_done_{false};
   KeyframeImageStore images_;
+  // The image of the current initialization attempt's first frame (tracking thread only): a new
+  // map's first keyframe is made of it, frames after it was seen.
+  cv::Mat initialization_image_;
   mutable std::mutex remeasured_mutex_;  // guards the four below
   Remeasurements remeasured_;
   bool remeasured_own_ = false;

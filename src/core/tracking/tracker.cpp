@@ -140,6 +140,7 @@ bool Tracker::initialize(Tracked& current, TrackingOutput& out) {
     if (current.frame.size() > static_cast<size_t>(settings_.init_min_matches)) {
       init_reference_ = current;
       init_prev_matched_ = current.frame.points;
+      out.initialization_reference = true;
     }
     return false;
   }
@@ -158,6 +159,7 @@ bool Tracker::initialize(Tracked& current, TrackingOutput& out) {
   if (static_cast<int>(p1.size()) < settings_.init_min_matches) {
     init_reference_ = current;  // too little overlap: start again from this frame
     init_prev_matched_ = current.frame.points;
+    out.initialization_reference = true;
     return false;
   }
   TwoViewOptions o;

@@ -31,6 +31,9 @@ struct TrackingOutput {
   RelativePose T_c_ref;                     // taken under the map lock
   std::shared_ptr<KeyFrame> new_keyframe;   // for local mapping (also the initial two)
   std::shared_ptr<Map> new_map;             // set when initialization created a map
+  // This frame is the first view of an initialization attempt: if the attempt succeeds, the new
+  // map's first keyframe (its origin) is made of it, and only new_map tells of that keyframe.
+  bool initialization_reference = false;
   int inliers = 0;
   // The frame's inlier matches: which point each keypoint saw, for SlamSystem::refineFrames.
   std::vector<FrameObservation> observations;
