@@ -2,14 +2,18 @@
 
 #include <fmt/format.h>
 
+#include <array>
+#include <filesystem>
 #include <map>
 
 #include "common/error.hpp"
 #include "core/features/orb_extractor.hpp"
 #include "core/optim/remeasure_observations.hpp"
 #include "core/system/slam_settings.hpp"
+#include "eval/similarity.hpp"
 #include "eval/trajectory_error.hpp"
 #include "io/open_dataset.hpp"
+#include "synth/sequence.hpp"
 
 namespace hiveslam::apps {
 
@@ -20,6 +24,65 @@ namespace {
 double finalBundleAdjustment(core::BaProblem& ba) {
   const double sigma = core::solveGlobal(ba, 50, core::SlamSettings{}.global_ba_noise_factor, core::Outliers::SecondRound, true);
   return core::medianResidualSigma(ba) * sigma;  // in level pixels
+}
+
+// What a rendered scene says of each map point: the surface its anchor's ray meets, its normal in
+// the map's frame, and what kind of surface it is.
+struct SceneNormals {
+  enum Surface { Room, Box, Pillar };
+  std::vector<std::optional<Eigen::Vector3d>> normal;  // problem.points order
+  std::vector<Surface> surface;
+};
+
+// The anchor's ray is cast from the anchor's true pose through its keypoint; the map's frame is
+// put on the world's by the similarity of the keyframe centres.
+SceneNormals sceneNormals(const synth::SequenceModel& model, const core::MapBaProblem& whole, const camera::CameraModel& camera) {
+  Eigen::Matrix3Xd map_centres(3, static_cast<long>(whole.keyframes.size())), true_centres(3, map_centres.cols());
+  for (size_t i = 0; i < whole.keyframes.size(); ++i) {
+    map_centres.col(static_cast<long>(i)) = whole.problem.poses[i].T_cw().inverse().translation();
+    true_centres.col(static_cast<long>(i)) = model.pose(static_cast<int>(whole.keyframes[i]->frame.index)).translation();
+  }
+  const Eigen::Matrix3d R_map_world = eval::umeyama(map_centres, true_centres, true).rotation.transpose();
+  const std::vector<int> anchor = core::pointAnchors(whole);
+  const auto& scene = model.scene;
+  const int first_pillar_texture = scene.pillars.empty() ? static_cast<int>(scene.textures.size()) : scene.pillars.front().texture;
+  SceneNormals out;
+  out.normal.resize(whole.points.size());
+  out.surface.resize(whole.points.size(), SceneNormals::Room);
+  for (size_t p = 0; p < whole.points.size(); ++p) {
+    const auto [kf, keypoint] = whole.sources[static_cast<size_t>(anchor[p])];
+    const cv::Point2f& pt = kf->frame.keypoints[static_cast<size_t>(keypoint)].pt;
+    const Eigen::Isometry3d T_wc = model.pose(static_cast<int>(kf->frame.index));
+    const auto hit = scene.intersect(T_wc.translation(), T_wc.linear() * camera.unproject({pt.x, pt.y}).normalized());
+    if (!hit) continue;
+    out.normal[p] = R_map_world * hit->normal;
+    out.surface[p] = hit->texture < 6 ? SceneNormals::Room : hit->texture < first_pillar_texture ? SceneNormals::Box : SceneNormals::Pillar;
+  }
+  return out;
+}
+
+// How far the normals patch alignment would use (the points' neighbours') are from the scene's,
+// by the kind of surface.
+void printNormalErrors(const SceneNormals& truth, const std::vector<std::optional<Eigen::Vector3d>>& fitted) {
+  constexpr std::array<double, 4> kBounds{5, 10, 20, 40};
+  std::array<std::array<size_t, 6>, 3> counts{};  // [surface][<5, 5-10, 10-20, 20-40, >40, no plane]
+  for (size_t p = 0; p < fitted.size(); ++p) {
+    if (!truth.normal[p]) continue;
+    auto& row = counts[truth.surface[p]];
+    if (!fitted[p]) {
+      ++row[5];
+      continue;
+    }
+    const double deg = std::acos(std::min(1.0, std::abs(fitted[p]->dot(*truth.normal[p])))) * 180.0 / M_PI;
+    size_t bin = 0;
+    while (bin < kBounds.size() && deg >= kBounds[bin]) ++bin;
+    ++row[bin];
+  }
+  fmt::print("normals against the scene's   {:>7} {:>7} {:>7} {:>7} {:>7} {:>8}\n", "<5", "5-10", "10-20", "20-40", ">40", "no plane");
+  const char* names[] = {"walls, floor, ceiling", "boxes", "pillars"};
+  for (size_t s = 0; s < counts.size(); ++s)
+    fmt::print("  {:<27} {:>7} {:>7} {:>7} {:>7} {:>7} {:>8}\n", names[s], counts[s][0], counts[s][1], counts[s][2], counts[s][3],
+               counts[s][4], counts[s][5]);
 }
 
 io::Trajectory keyframeTrajectory(const core::BaProblem& ba, const std::vector<double>& stamps) {
@@ -58,8 +121,22 @@ void evalRemeasure(const std::shared_ptr<core::Map>& map, const std::string& dat
     throw InputError(fmt::format("the dataset holds the images of {} of the map's {} keyframes", images.size(), by_frame.size()));
 
   core::BaProblem detected = whole.problem;
-  const core::RemeasureStats stats = core::remeasureObservations(
-      whole, camera, [&](const core::KeyFrame& k) { return std::shared_ptr<const features::ImagePyramid>(std::shared_ptr<void>(), &images.at(&k)); });
+  // A rendered sequence's scene is the oracle for the normals (hiveslam synth writes sequence.json).
+  std::optional<SceneNormals> scene;
+  if (std::filesystem::exists(std::filesystem::path(dataset) / "sequence.json"))
+    scene = sceneNormals(synth::buildSequence(synth::readSequenceOptions(dataset)), whole, camera);
+  const core::KeyframeImages at_hand = [&](const core::KeyFrame& k) {
+    return std::shared_ptr<const features::ImagePyramid>(std::shared_ptr<void>(), &images.at(&k));
+  };
+  core::MapBaProblem through_scene = whole;
+  if (scene) {
+    std::vector<Eigen::Vector3d> positions;
+    for (const core::BaPoint& p : whole.problem.points) positions.push_back(p.p_w);
+    const auto fitted = core::planeNormals(positions);
+    printNormalErrors(*scene, fitted);
+    core::remeasureObservations(through_scene, camera, at_hand, scene->normal);
+  }
+  const core::RemeasureStats stats = core::remeasureObservations(whole, camera, at_hand);
   fmt::print("map {}: {} keyframes, {} points, {} observations: {} anchors, {} measured again, {} kept as found; "
              "{} points with a plane from their neighbours\n",
              map->id, whole.keyframes.size(), whole.points.size(), whole.problem.observations.size(), stats.anchors,
@@ -76,6 +153,10 @@ void evalRemeasure(const std::shared_ptr<core::Map>& map, const std::string& dat
   report("whole-map BA, detected corners", detected, detected_noise);
   const double remeasured_noise = finalBundleAdjustment(whole.problem);
   report("whole-map BA, re-measured", whole.problem, remeasured_noise);
+  if (scene) {
+    const double scene_noise = finalBundleAdjustment(through_scene.problem);
+    report("whole-map BA, the scene's normals", through_scene.problem, scene_noise);
+  }
 }
 
 }  // namespace hiveslam::apps

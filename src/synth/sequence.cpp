@@ -192,4 +192,30 @@ SequenceSummary writeSequence(const SequenceOptions& o, const fs::path& out,
   return summary;
 }
 
+SequenceOptions readSequenceOptions(const fs::path& dataset) {
+  const fs::path file = dataset / "sequence.json";
+  std::ifstream in(file);
+  if (!in) throw InputError("not a synthetic sequence (no " + file.string() + ")");
+  const auto info = nlohmann::json::parse(in, nullptr, false);
+  if (info.is_discarded() || !info.is_object()) throw InputError(file.string() + " is not JSON");
+  try {
+    SequenceOptions o;
+    o.trajectory = info.at("trajectory").get<std::string>();
+    o.seed = info.at("seed").get<uint64_t>();
+    o.frames = info.at("frames").get<int>();
+    o.fps = info.at("fps").get<double>();
+    o.width = info.at("size").at(0).get<int>();
+    o.height = info.at("size").at(1).get<int>();
+    o.distortion = info.at("distortion").get<bool>();
+    o.noise = info.at("noise").get<double>();
+    o.motion_blur = info.at("motion_blur").get<bool>();
+    o.exposure_changes = info.at("exposure_changes").get<bool>();
+    const auto textures = info.at("textures").get<std::string>();
+    if (textures != "procedural") o.textures = textures;
+    return o;
+  } catch (const nlohmann::json::exception& e) {
+    throw InputError(file.string() + ": not what hiveslam synth writes (" + e.what() + ")");
+  }
+}
+
 }  // namespace hiveslam::synth

@@ -46,6 +46,11 @@ struct SequenceModel {
 
 SequenceModel buildSequence(const SequenceOptions& options);
 
+// The options a sequence written by writeSequence was made with, from its `sequence.json`: with
+// them buildSequence rebuilds its scene and path exactly (the oracle of evaluations that need
+// more than the ground-truth poses). InputError where the file is missing or malformed.
+SequenceOptions readSequenceOptions(const std::filesystem::path& dataset);
+
 struct SequenceSummary {
   int frames = 0, blank_frames = 0;
   double path_length = 0.0, duration = 0.0, render_seconds = 0.0;

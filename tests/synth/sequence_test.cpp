@@ -1,6 +1,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <fstream>
 #include <opencv2/imgproc.hpp>
 
 #include "common/error.hpp"
@@ -155,6 +156,38 @@ TEST(Sequence, WritesEurocLayout) {
   for (const char* f : {"mav0/cam0/data.csv", "mav0/cam0/sensor.yaml", "mav0/state_groundtruth_estimate0/data.csv",
                         "sequence.json", "mav0/cam0/data/1000000000000.png", "mav0/cam0/data/1000050000000.png"})
     EXPECT_TRUE(std::filesystem::exists(dir / f)) << f;
+}
+
+TEST(Sequence, ItsOptionsReadBackRebuildTheSameScene) {
+  testing::TempDir dir;
+  SequenceOptions o;
+  o.width = 64;
+  o.height = 48;
+  o.frames = 3;
+  o.trajectory = "blackout";
+  o.seed = 7;
+  o.distortion = true;
+  o.exposure_changes = true;
+  o.noise = 1.5;
+  writeSequence(o, dir.path());
+  const SequenceOptions back = readSequenceOptions(dir.path());
+  EXPECT_EQ(back.trajectory, o.trajectory);
+  EXPECT_EQ(back.seed, o.seed);
+  EXPECT_EQ(back.frames, o.frames);
+  EXPECT_EQ(back.width, o.width);
+  EXPECT_EQ(back.height, o.height);
+  EXPECT_EQ(back.distortion, o.distortion);
+  EXPECT_EQ(back.exposure_changes, o.exposure_changes);
+  EXPECT_DOUBLE_EQ(back.noise, o.noise);
+  EXPECT_TRUE(back.textures.empty());
+  const SequenceModel a = buildSequence(o), b = buildSequence(back);
+  ASSERT_EQ(a.scene.boxes.size(), b.scene.boxes.size());
+  for (size_t i = 0; i < a.scene.boxes.size(); ++i) EXPECT_EQ(a.scene.boxes[i].center, b.scene.boxes[i].center);
+  EXPECT_TRUE(a.pose(2).isApprox(b.pose(2)));
+
+  EXPECT_THROW(readSequenceOptions(dir / "mav0"), InputError);  // no sequence.json there
+  std::ofstream(dir / "sequence.json") << "{\"trajectory\": \"sweep\"}";
+  EXPECT_THROW(readSequenceOptions(dir.path()), InputError);  // not all of what synth writes
 }
 
 }  // namespace

@@ -10,11 +10,16 @@ namespace hiveslam::core {
 
 RemeasureStats remeasureObservations(MapBaProblem& mp, const camera::CameraModel& camera, const KeyframeImages& images,
                                      const RemeasureOptions& options, Remeasurements* measured) {
+  std::vector<Eigen::Vector3d> positions;
+  for (const BaPoint& p : mp.problem.points) positions.push_back(p.p_w);
+  return remeasureObservations(mp, camera, images, planeNormals(positions, options.normals), options, measured);
+}
+
+RemeasureStats remeasureObservations(MapBaProblem& mp, const camera::CameraModel& camera, const KeyframeImages& images,
+                                     const std::vector<std::optional<Eigen::Vector3d>>& normals,
+                                     const RemeasureOptions& options, Remeasurements* measured) {
   RemeasureStats stats;
   BaProblem& ba = mp.problem;
-  std::vector<Eigen::Vector3d> positions;
-  for (const BaPoint& p : ba.points) positions.push_back(p.p_w);
-  const auto normals = planeNormals(positions, options.normals);
   const std::vector<int> anchor = pointAnchors(mp);
   // Anchor by anchor (in keyframe order), and each anchor's views in keyframe order.
   std::vector<size_t> order(ba.observations.size());

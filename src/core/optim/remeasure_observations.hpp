@@ -46,4 +46,10 @@ using KeyframeImages = std::function<std::shared_ptr<const features::ImagePyrami
 RemeasureStats remeasureObservations(MapBaProblem& mp, const camera::CameraModel& camera, const KeyframeImages& images,
                                      const RemeasureOptions& options = {}, Remeasurements* measured = nullptr);
 
+// The same through the normals given (problem.points order; nothing: facing the anchor) instead
+// of those of the points' neighbours: evaluations compare the normals a scene really has.
+RemeasureStats remeasureObservations(MapBaProblem& mp, const camera::CameraModel& camera, const KeyframeImages& images,
+                                     const std::vector<std::optional<Eigen::Vector3d>>& normals,
+                                     const RemeasureOptions& options = {}, Remeasurements* measured = nullptr);
+
 }  // namespace hiveslam::core
