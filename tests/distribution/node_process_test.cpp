@@ -2,6 +2,10 @@
 // three network namespaces joined by a bridge, each node with its own network stack as on
 // separate devices (root only; skipped with a message where namespaces cannot be made).
 #include <gtest/gtest.h>
+#include <netinet/in.h>
+#include <spawn.h>
+#include <sys/socket.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -10,10 +14,13 @@
 #include <iostream>
 #include <nlohmann/json.hpp>
 #include <sstream>
+#include <vector>
 
 #include "io/atlas_file.hpp"
 #include "synth/sequence.hpp"
 #include "temp_dir.hpp"
+
+extern char** environ;
 
 namespace hiveslam {
 namespace {
@@ -46,6 +53,37 @@ nlohmann::json report(const fs::path& file) {
   std::ifstream in(file);
   EXPECT_TRUE(in.good()) << file;
   return in ? nlohmann::json::parse(in) : nlohmann::json::object();
+}
+
+// The sockets a process holds open now: its descriptors that link to "socket:[inode]".
+int openSockets(pid_t pid) {
+  int n = 0;
+  std::error_code ec;
+  for (const auto& fd : fs::directory_iterator(fs::path("/proc") / std::to_string(pid) / "fd", ec)) {
+    std::error_code gone;  // a descriptor closed between the listing and the read
+    n += fs::read_symlink(fd.path(), gone).string().starts_with("socket:");
+  }
+  return n;
+}
+
+// The processes whose parent is `parent`, from /proc/N/stat ("N (comm) state ppid ...").
+std::vector<pid_t> childrenOf(pid_t parent) {
+  std::vector<pid_t> children;
+  std::error_code ec;
+  for (const auto& entry : fs::directory_iterator("/proc", ec)) {
+    const std::string name = entry.path().filename().string();
+    if (name.find_first_not_of("0123456789") != std::string::npos) continue;
+    std::ifstream stat(entry.path() / "stat");
+    std::string line;
+    std::getline(stat, line);
+    const auto comm_end = line.rfind(')');  // the command's name may hold spaces and brackets
+    if (comm_end == std::string::npos) continue;
+    std::istringstream rest(line.substr(comm_end + 1));
+    char state = 0;
+    pid_t ppid = 0;
+    if (rest >> state >> ppid && ppid == parent) children.push_back(std::stoi(name));
+  }
+  return children;
 }
 
 // Whether a node's frame log (frames.csv: index, timestamp, tracked, ...) shows it tracking
@@ -258,11 +296,29 @@ TEST(NodeProcesses, ThreeNodesOverLoopback) {
 
 TEST(NodeProcesses, OneNodeIsTheStandaloneSystem) {
   testing::TempDir out;
-  const std::string cmd = std::string(HIVESLAM_BINARY) + " cluster --nodes 1 " + sequence().string() + " --out " +
-                          out.path().string() + " > " + (out / "log").string() + " 2>&1";
-  ASSERT_EQ(std::system(cmd.c_str()), 0) << std::ifstream(out / "log").rdbuf();
+  // The counter sees a socket where there is one: this process's own.
+  const int own = socket(AF_INET, SOCK_DGRAM, 0);
+  ASSERT_GE(own, 0);
+  EXPECT_EQ(openSockets(getpid()), 1);
+  close(own);
+  const std::string cmd = "exec " + std::string(HIVESLAM_BINARY) + " cluster --nodes 1 " + sequence().string() +
+                          " --out " + out.path().string() + " > " + (out / "log").string() + " 2>&1";
+  const char* argv[] = {"/bin/sh", "-c", cmd.c_str(), nullptr};
+  pid_t cluster = 0;
+  ASSERT_EQ(posix_spawn(&cluster, "/bin/sh", nullptr, nullptr, const_cast<char**>(argv), environ), 0);
+  // Looked at while it runs: a DDS participant holds its UDP sockets from its start to its end,
+  // so one made by the cluster command or its TR process (`hiveslam run`) would be seen.
+  int looks_at_tr = 0, sockets = 0, status = 0;
+  while (waitpid(cluster, &status, WNOHANG) == 0) {
+    sockets = std::max(sockets, openSockets(cluster));
+    for (const pid_t tr : childrenOf(cluster)) ++looks_at_tr, sockets = std::max(sockets, openSockets(tr));
+    usleep(20'000);
+  }
+  ASSERT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << std::ifstream(out / "log").rdbuf();
+  EXPECT_GT(looks_at_tr, 10);
+  EXPECT_EQ(sockets, 0);
   const auto tr = report(out / "tr" / "report.json");
-  EXPECT_FALSE(tr.contains("topics"));  // no transport was made: no participant, no socket
+  EXPECT_FALSE(tr.contains("topics"));  // no transport was made
   EXPECT_FALSE(fs::exists(out / "lm"));
   EXPECT_GT(tr.value("tracked_frames", 0), 200);
 }
