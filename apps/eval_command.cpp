@@ -8,6 +8,7 @@
 #include <nlohmann/json.hpp>
 
 #include <fstream>
+#include <sstream>
 
 #include "apps/bench.hpp"
 #include "apps/commands.hpp"
@@ -199,8 +200,20 @@ void addEvalCommand(CLI::App& app) {
       ->required();
   addSplit(remeasure_cmd, *remeasure_split);
   remeasure_cmd->add_option("--map", *remeasure_map, "Map id (default: the one with the most keyframes)");
+  auto remeasure_leave_out = std::make_shared<std::vector<std::string>>();
+  remeasure_cmd->add_option("--leave-out", *remeasure_leave_out,
+                            "FROM:TO, seconds from the first keyframe: solve again without those keyframes (repeatable)");
   remeasure_cmd->callback([=]() {
-    evalRemeasure(pickMap(io::loadAtlas(*remeasure_atlas), *remeasure_map), *remeasure_dataset, *remeasure_split);
+    std::vector<std::pair<double, double>> windows;
+    for (const std::string& w : *remeasure_leave_out) {
+      double from = 0, to = 0;
+      char colon = 0;
+      std::istringstream in(w);
+      if (!(in >> from >> colon >> to) || colon != ':' || to < from || !(in >> std::ws).eof())
+        throw InputError("--leave-out takes FROM:TO in seconds, not '" + w + "'");
+      windows.emplace_back(from, to);
+    }
+    evalRemeasure(pickMap(io::loadAtlas(*remeasure_atlas), *remeasure_map), *remeasure_dataset, *remeasure_split, windows);
   });
 
   auto bench_file = std::make_shared<std::string>();

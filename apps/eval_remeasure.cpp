@@ -2,6 +2,7 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <array>
 #include <filesystem>
 #include <map>
@@ -85,6 +86,19 @@ void printNormalErrors(const SceneNormals& truth, const std::vector<std::optiona
                counts[s][4], counts[s][5]);
 }
 
+// The problem without the observations of the poses `out` marks, and without the points that
+// leaves with fewer than two.
+core::BaProblem withoutPoses(const core::BaProblem& ba, const std::vector<bool>& out) {
+  core::BaProblem kept = ba;
+  kept.observations.clear();
+  std::vector<int> views(ba.points.size(), 0);
+  for (const auto& ob : ba.observations)
+    if (!out[static_cast<size_t>(ob.pose)]) ++views[static_cast<size_t>(ob.point)];
+  for (const auto& ob : ba.observations)
+    if (!out[static_cast<size_t>(ob.pose)] && views[static_cast<size_t>(ob.point)] >= 2) kept.observations.push_back(ob);
+  return kept;
+}
+
 io::Trajectory keyframeTrajectory(const core::BaProblem& ba, const std::vector<double>& stamps) {
   io::Trajectory t;
   for (size_t i = 0; i < ba.poses.size(); ++i) t.add(stamps[i], ba.poses[i].T_cw().inverse());
@@ -93,7 +107,8 @@ io::Trajectory keyframeTrajectory(const core::BaProblem& ba, const std::vector<d
 
 }  // namespace
 
-void evalRemeasure(const std::shared_ptr<core::Map>& map, const std::string& dataset, const eval::StretchSplit& split) {
+void evalRemeasure(const std::shared_ptr<core::Map>& map, const std::string& dataset, const eval::StretchSplit& split,
+                   const std::vector<std::pair<double, double>>& leave_out) {
   auto source = io::openDataset(dataset);
   if (!source->groundTruth()) throw InputError("the dataset has no ground truth: " + dataset);
   const io::Trajectory& gt = *source->groundTruth();
@@ -151,8 +166,17 @@ void evalRemeasure(const std::shared_ptr<core::Map>& map, const std::string& dat
   report("as saved", detected, core::medianResidualSigma(detected));
   const double detected_noise = finalBundleAdjustment(detected);
   report("whole-map BA, detected corners", detected, detected_noise);
+  const core::BaProblem remeasured = whole.problem;
   const double remeasured_noise = finalBundleAdjustment(whole.problem);
   report("whole-map BA, re-measured", whole.problem, remeasured_noise);
+  for (const auto& [from, to] : leave_out) {
+    std::vector<bool> out(stamps.size(), false);
+    for (size_t k = 0; k < stamps.size(); ++k) out[k] = stamps[k] - stamps.front() >= from && stamps[k] - stamps.front() <= to;
+    core::BaProblem cut = withoutPoses(remeasured, out);
+    const double noise = finalBundleAdjustment(cut);
+    report(fmt::format("re-measured, {:.2f}-{:.2f} s left out ({})", from, to, std::count(out.begin(), out.end(), true)).c_str(),
+           cut, noise);
+  }
   if (scene) {
     const double scene_noise = finalBundleAdjustment(through_scene.problem);
     report("whole-map BA, the scene's normals", through_scene.problem, scene_noise);

@@ -2,6 +2,7 @@
 // same input gives the same trajectory.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <map>
@@ -10,6 +11,7 @@
 #include <vector>
 
 #include "core/camera/pinhole_radtan.hpp"
+#include "core/mapping/keyframe_gap.hpp"
 #include "core/system/slam_system.hpp"
 #include "eval/similarity.hpp"
 #include "eval/trajectory_error.hpp"
@@ -24,6 +26,7 @@ struct SlamRun {
   int loops = 0, merges = 0, global_bas = 0;
   size_t live_maps = 0, keyframes = 0;
   int keyframes_deferred = 0;
+  double widest_keyframe_step_deg = 0;  // between keyframes next in time, the largest map's
 };
 
 std::shared_ptr<const place::Vocabulary> shippedVocabulary() {
@@ -70,6 +73,12 @@ SlamRun runSequence(const std::string& trajectory, int total, int first, int cou
   {
     std::lock_guard lock(map->mutex);
     run.keyframes = map->keyframes.size();
+    std::vector<const KeyFrame*> chain;
+    for (const auto& [id, kf] : map->keyframes) chain.push_back(kf.get());
+    std::sort(chain.begin(), chain.end(), [](auto* a, auto* b) { return a->frame.timestamp < b->frame.timestamp; });
+    for (size_t i = 1; i < chain.size(); ++i)
+      run.widest_keyframe_step_deg =
+          std::max(run.widest_keyframe_step_deg, viewAngleDegrees(chain[i - 1]->T_cw.linear(), chain[i]->T_cw.linear()));
   }
   return run;
 }
@@ -331,6 +340,25 @@ TEST(SlamSystem, RealTimeTrackingCountsTheKeyframesThatWaitedOnMapping) {
   const SlamRun realtime = runSequence("sweep", 600, 100, 80, 4, SlamSystem::Mode::Realtime);
   EXPECT_GT(realtime.tracked, 60);
   EXPECT_GT(realtime.keyframes_deferred, 0);
+}
+
+// Through sweep's U-turn (up to 50 degrees a second) the keyframe chain carries the map's scale:
+// with the turn rules (5 degrees, the default), tracking makes a keyframe every few degrees and
+// culling keeps them, so no two keyframes next in time are more than the limit plus a frame's
+// turn (2.5 degrees) apart. Without them two were 13 degrees apart here.
+TEST(SlamSystem, TurnRulesKeepTheKeyframeChainDenseThroughATurn) {
+  SlamSettings plain_settings;
+  plain_settings.keyframe_turn_deg = 0.0;
+  plain_settings.keyframe_culling_max_angle_deg = 0.0;
+  const SlamRun plain = runSequence("sweep", 800, 300, 130, 4, SlamSystem::Mode::Sequential, nullptr, plain_settings);
+  SlamSettings dense;
+  ASSERT_EQ(dense.keyframe_turn_deg, 5.0);
+  ASSERT_EQ(dense.keyframe_culling_max_angle_deg, 5.0);
+  const SlamRun turn = runSequence("sweep", 800, 300, 130, 4, SlamSystem::Mode::Sequential, nullptr, dense);
+  EXPECT_GT(plain.widest_keyframe_step_deg, 8.0) << "the rules have nothing to do on this stretch";
+  EXPECT_LE(turn.widest_keyframe_step_deg, 8.0);
+  EXPECT_GT(turn.keyframes, plain.keyframes);
+  EXPECT_GE(turn.tracked, 0.95 * turn.frames);
 }
 
 // The distribution layer sends a keyframe's new points before local BA (TR tracks with them a

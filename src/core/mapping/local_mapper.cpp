@@ -8,6 +8,7 @@
 #include "core/features/rotation_histogram.hpp"
 #include "core/geometry/skew.hpp"
 #include "core/geometry/triangulation.hpp"
+#include "core/mapping/keyframe_gap.hpp"
 #include "core/mapping/keyframe_insertion.hpp"
 #include "core/matching/bow_matcher.hpp"
 #include "core/matching/fusion.hpp"
@@ -294,7 +295,8 @@ void LocalMapper::cullKeyframes(Map& map, KeyFrame& kf) {
         if (o != k && o->frame.keypoints[static_cast<size_t>(idx)].octave <= level + 1 && ++others >= 3) break;
       if (others >= 3) ++redundant;
     }
-    if (total > 0 && redundant > settings_.redundant_keyframe_ratio * total) {
+    if (total > 0 && redundant > settings_.redundant_keyframe_ratio * total &&
+        !cullingLeavesGap(*k, settings_.keyframe_culling_max_angle_deg)) {
       map.erase(*k);
       if (database_) database_->erase(k);
       ++stats_.keyframes_culled;

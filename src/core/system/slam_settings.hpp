@@ -30,6 +30,13 @@ struct SlamSettings {
   // map's keyframes waited 20 frames for it and TR lost 3 of its first maps in 24 runs.
   // On the standard suite no keyframe waits that long (the lowest share seen is 0.67).
   double keyframe_weak_ratio = 0.5;
+  // Past this many degrees of turn since the last keyframe a keyframe is due, and made even while
+  // mapping is busy (0: no such rule). The keyframe chain carries a monocular map's scale through
+  // a fast turn, and a gap there bends the map (core/mapping/keyframe_gap.hpp). With this and the
+  // culling limit below at 5 degrees, 3-node real-time sweep runs keep about 12 more keyframes
+  // (102 against 90) and lost their tail in 8 interleaved pairs; at 10 degrees they kept it
+  // (docs/BENCHMARKS.md, session 59).
+  double keyframe_turn_deg = 5.0;
   int keyframe_min_inliers = 15;
   // Loss handling: a new map after this many lost frames once the map is past its first
   // keyframes (the paper's wait for the initial keyframes to be optimized).
@@ -56,6 +63,10 @@ struct SlamSettings {
   // bench: all four sequences), but the 3-node system got worse with it (sweep median 5.2 mm
   // over 7 runs at 0.9, about 10 over 8 at 0.95): docs/BENCHMARKS.md, session 8.
   double redundant_keyframe_ratio = 0.9;
+  // A redundant keyframe stays when its neighbours in time would be more than this many degrees
+  // apart in viewing direction without it (0: no limit; core/mapping/keyframe_gap.hpp, and
+  // keyframe_turn_deg above).
+  double keyframe_culling_max_angle_deg = 5.0;
   // Loop closing and map merging
   bool loop_closing = true;
   std::string vocabulary;              // file; empty: the one shipped in data/vocabulary

@@ -8,6 +8,7 @@
 
 #include "core/features/hamming.hpp"
 #include "core/geometry/two_view.hpp"
+#include "core/mapping/keyframe_gap.hpp"
 #include "core/matching/bow_matcher.hpp"
 #include "core/matching/initial_matcher.hpp"
 #include "core/optim/bundle_adjustment.hpp"
@@ -100,6 +101,7 @@ TrackingOutput Tracker::track(Frame frame, bool mapping_idle) {
     if (!mapping_idle) ++keyframes_made_busy_;
     reference_ = out.new_keyframe;
     last_keyframe_frame_ = current.frame.index;
+    last_keyframe_R_cw_ = current.T_cw.linear();
   } else if (decision == KeyframeDecision::Deferred) {
     ++keyframes_deferred_;
   }
@@ -242,6 +244,7 @@ bool Tracker::initialize(Tracked& current, TrackingOutput& out) {
   last_ = current;
   have_velocity_ = false;
   last_keyframe_frame_ = current.frame.index;
+  last_keyframe_R_cw_ = current.T_cw.linear();
   init_reference_.reset();
   out.new_map = map;
   out.new_keyframe = kf2;
@@ -451,9 +454,13 @@ double Tracker::trackedShare() const {
   return reference_points > 0 ? static_cast<double>(inliers_) / reference_points : std::numeric_limits<double>::infinity();
 }
 
+bool Tracker::turnedFromKeyframe(const Tracked& c) const {
+  return settings_.keyframe_turn_deg > 0 && viewAngleDegrees(last_keyframe_R_cw_, c.T_cw.linear()) > settings_.keyframe_turn_deg;
+}
+
 bool Tracker::keyframeWanted(const Tracked& c, double share) const {
   if (c.frame.index - last_keyframe_frame_ < static_cast<size_t>(settings_.keyframe_min_frames)) return false;
-  return share < settings_.keyframe_ratio && inliers_ > settings_.keyframe_min_inliers;
+  return (share < settings_.keyframe_ratio || turnedFromKeyframe(c)) && inliers_ > settings_.keyframe_min_inliers;
 }
 
 Tracker::KeyframeDecision Tracker::keyframeDecision(const Tracked& c, bool mapping_idle) const {
@@ -464,7 +471,7 @@ Tracker::KeyframeDecision Tracker::keyframeDecision(const Tracked& c, bool mappi
   if (!keyframeWanted(c, share)) return KeyframeDecision::None;  // also: too soon after the last one
   const size_t since = c.frame.index - last_keyframe_frame_;
   const bool timely = since >= static_cast<size_t>(settings_.keyframe_max_frames) || mapping_idle ||
-                      share < settings_.keyframe_weak_ratio;
+                      share < settings_.keyframe_weak_ratio || turnedFromKeyframe(c);
   return timely ? KeyframeDecision::Make : KeyframeDecision::Deferred;
 }
 

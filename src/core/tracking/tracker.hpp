@@ -86,6 +86,8 @@ class Tracker {
   int optimize(Tracked& current);
   // Made, or due but held back because mapping is busy (counted as deferred), or neither.
   enum class KeyframeDecision { None, Make, Deferred };
+  // Whether the view has turned more than keyframe_turn_deg from the last keyframe's.
+  bool turnedFromKeyframe(const Tracked& current) const;
   KeyframeDecision keyframeDecision(const Tracked& current, bool mapping_idle) const;
   // The point-ratio half of the decision, given trackedShare().
   bool keyframeWanted(const Tracked& current, double share) const;
@@ -107,6 +109,7 @@ class Tracker {
   Eigen::Isometry3d velocity_ = Eigen::Isometry3d::Identity();
   bool have_velocity_ = false;
   size_t last_keyframe_frame_ = 0;
+  Eigen::Matrix3d last_keyframe_R_cw_ = Eigen::Matrix3d::Identity();
   // None until the tracker relocalizes: the stricter checks that follow a relocalization (a
   // pose found by PnP against a place may be wrong) are not for a map just initialized, whose
   // first frames on a forward-moving car hold 40-50 inliers and were dropped as lost.
