@@ -343,17 +343,17 @@ TEST(SlamSystem, RealTimeTrackingCountsTheKeyframesThatWaitedOnMapping) {
 }
 
 // Through sweep's U-turn (up to 50 degrees a second) the keyframe chain carries the map's scale:
-// with the turn rules (5 degrees, the default), tracking makes a keyframe every few degrees and
-// culling keeps them, so no two keyframes next in time are more than the limit plus a frame's
-// turn (2.5 degrees) apart. Without them two were 13 degrees apart here.
+// with the turn rules at 5 degrees, tracking makes a keyframe every few degrees and culling keeps
+// them, so no two keyframes next in time are more than the limit plus a frame's turn (2.5
+// degrees) apart. Without them two were 13 degrees apart here.
 TEST(SlamSystem, TurnRulesKeepTheKeyframeChainDenseThroughATurn) {
   SlamSettings plain_settings;
   plain_settings.keyframe_turn_deg = 0.0;
   plain_settings.keyframe_culling_max_angle_deg = 0.0;
   const SlamRun plain = runSequence("sweep", 800, 300, 130, 4, SlamSystem::Mode::Sequential, nullptr, plain_settings);
   SlamSettings dense;
-  ASSERT_EQ(dense.keyframe_turn_deg, 5.0);
-  ASSERT_EQ(dense.keyframe_culling_max_angle_deg, 5.0);
+  dense.keyframe_turn_deg = 5.0;
+  dense.keyframe_culling_max_angle_deg = 5.0;
   const SlamRun turn = runSequence("sweep", 800, 300, 130, 4, SlamSystem::Mode::Sequential, nullptr, dense);
   EXPECT_GT(plain.widest_keyframe_step_deg, 8.0) << "the rules have nothing to do on this stretch";
   EXPECT_LE(turn.widest_keyframe_step_deg, 8.0);

@@ -34,9 +34,11 @@ struct SlamSettings {
   // mapping is busy (0: no such rule). The keyframe chain carries a monocular map's scale through
   // a fast turn, and a gap there bends the map (core/mapping/keyframe_gap.hpp). With this and the
   // culling limit below at 5 degrees, 3-node real-time sweep runs keep about 12 more keyframes
-  // (102 against 90) and lost their tail in 8 interleaved pairs; at 10 degrees they kept it
-  // (docs/BENCHMARKS.md, session 59).
-  double keyframe_turn_deg = 5.0;
+  // (102 against 90) and lost their tail in 8 interleaved pairs, and bench64 held every rule; at
+  // 10 degrees they kept it. Off for now: the standalone system's CPU on figure8 rose 65%, and
+  // SlamSystem.ClosesTheLoopOfARenderedLoop no longer saw loop closing halve the revisit gap
+  // (docs/BENCHMARKS.md, session 59). Set 5 to use it.
+  double keyframe_turn_deg = 0.0;
   int keyframe_min_inliers = 15;
   // Loss handling: a new map after this many lost frames once the map is past its first
   // keyframes (the paper's wait for the initial keyframes to be optimized).
@@ -66,7 +68,7 @@ struct SlamSettings {
   // A redundant keyframe stays when its neighbours in time would be more than this many degrees
   // apart in viewing direction without it (0: no limit; core/mapping/keyframe_gap.hpp, and
   // keyframe_turn_deg above).
-  double keyframe_culling_max_angle_deg = 5.0;
+  double keyframe_culling_max_angle_deg = 0.0;
   // Loop closing and map merging
   bool loop_closing = true;
   std::string vocabulary;              // file; empty: the one shipped in data/vocabulary
