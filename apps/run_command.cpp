@@ -29,10 +29,16 @@
 namespace hiveslam::apps {
 
 nlohmann::json mappingStatsJson(const core::MappingStats& ms) {
+  const core::MappingStageMs& t = ms.ms;
+  const double n = std::max(ms.keyframes_processed, 1);
   return {{"keyframes_processed", ms.keyframes_processed}, {"points_created", ms.points_created},
           {"points_culled", ms.points_culled}, {"keyframes_culled", ms.keyframes_culled},
           {"local_bas", ms.local_bas}, {"local_bas_discarded", ms.local_bas_discarded},
-          {"local_bas_cut_short", ms.local_bas_cut_short}};
+          {"local_bas_cut_short", ms.local_bas_cut_short},
+          {"ms_per_keyframe",
+           {{"insert", t.insert / n}, {"cull_points", t.cull_points / n}, {"triangulate", t.triangulate / n},
+            {"fuse", t.fuse / n}, {"local_ba_setup", t.local_ba_setup / n}, {"local_ba", t.local_ba / n},
+            {"cull_keyframes", t.cull_keyframes / n}, {"total", t.total / n}, {"max_total", t.max_total}}}};
 }
 
 nlohmann::json remeasureJson(const core::SlamSystem::RemeasureReport& r, const core::RemeasurementUse& use) {

@@ -90,6 +90,30 @@ TEST(SlamSystem, TracksARenderedLoopAccurately) {
   EXPECT_LT(ate.stats.rmse, 0.01 * ate.reference_length) << ate.stats.rmse << " m over " << ate.reference_length;
 }
 
+// Local mapping times each stage of each keyframe, so that a run's report says where its time
+// goes (`mapping.ms_per_keyframe`).
+TEST(SlamSystem, LocalMappingTimesEachStage) {
+  synth::SequenceOptions o;
+  o.trajectory = "loop";
+  o.frames = 400;
+  const auto model = synth::buildSequence(o);
+  const synth::RayTable rays(model.lens);
+  auto camera = std::make_shared<camera::PinholeRadTan>(model.lens.width, model.lens.height, model.lens.fx,
+                                                        model.lens.fy, model.lens.cx, model.lens.cy);
+  SlamSystem slam({}, camera, SlamSystem::Mode::Sequential);
+  for (int f = 0; f < 60; ++f) slam.process(model.renderImage(f, rays), model.stamp(f));
+  slam.finish();
+  const MappingStats& stats = slam.mappingStats();
+  ASSERT_GE(stats.keyframes_processed, 3);
+  const MappingStageMs& ms = stats.ms;
+  for (double stage : {ms.insert, ms.triangulate, ms.fuse, ms.local_ba_setup, ms.local_ba, ms.cull_keyframes})
+    EXPECT_GT(stage, 0.0);
+  EXPECT_NEAR(ms.total, ms.insert + ms.cull_points + ms.triangulate + ms.fuse + ms.local_ba_setup + ms.local_ba + ms.cull_keyframes,
+              1e-6 * ms.total);
+  EXPECT_GE(ms.max_total, ms.total / stats.keyframes_processed);
+  EXPECT_LE(ms.max_total, ms.total);
+}
+
 // Threaded: tracking on this thread, local mapping on its own. Thread timing varies with the
 // machine's load, so the bar is lower than the deterministic run's; TSan runs this test too.
 TEST(SlamSystem, ThreadedModeTracks) {

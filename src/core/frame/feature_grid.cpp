@@ -15,7 +15,15 @@ FeatureGrid::FeatureGrid(const std::vector<Eigen::Vector2d>& points, double min_
       index_(points.size()) {
   // Counting sort by cell: a stable grouping, so each cell lists its points in index order.
   std::vector<int> cell_of(points.size());
+  if (!points.empty()) {
+    lo_x_ = hi_x_ = points[0].x();
+    lo_y_ = hi_y_ = points[0].y();
+  }
   for (size_t i = 0; i < points.size(); ++i) {
+    lo_x_ = std::min(lo_x_, points[i].x());
+    hi_x_ = std::max(hi_x_, points[i].x());
+    lo_y_ = std::min(lo_y_, points[i].y());
+    hi_y_ = std::max(hi_y_, points[i].y());
     cell_of[i] = cellY(points[i].y()) * kCols + cellX(points[i].x());
     ++start_[static_cast<size_t>(cell_of[i]) + 1];
   }
@@ -25,7 +33,5 @@ FeatureGrid::FeatureGrid(const std::vector<Eigen::Vector2d>& points, double min_
     index_[static_cast<size_t>(fill[static_cast<size_t>(cell_of[i])]++)] = static_cast<int>(i);
 }
 
-int FeatureGrid::cellX(double x) const { return std::clamp(static_cast<int>(std::floor((x - min_x_) * inv_w_)), 0, kCols - 1); }
-int FeatureGrid::cellY(double y) const { return std::clamp(static_cast<int>(std::floor((y - min_y_) * inv_h_)), 0, kRows - 1); }
 
 }  // namespace hiveslam::core

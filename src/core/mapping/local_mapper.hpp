@@ -13,10 +13,25 @@
 
 namespace hiveslam::core {
 
+// Milliseconds local mapping spent per stage, summed over the keyframes it processed. The
+// local BA's solve runs without the map lock; the other stages hold it.
+struct MappingStageMs {
+  double insert = 0;          // the keyframe into the map, its links, garbage collection
+  double cull_points = 0;     // recent points that did not hold up
+  double triangulate = 0;     // new points with covisible keyframes
+  double fuse = 0;            // duplicates merged with the neighbours' points
+  double local_ba_setup = 0;  // the problem copied out and the result applied
+  double local_ba = 0;        // the solve
+  double cull_keyframes = 0;  // redundant keyframes
+  double total = 0;
+  double max_total = 0;       // the slowest keyframe
+};
+
 struct MappingStats {
   int keyframes_processed = 0, points_created = 0, points_culled = 0, keyframes_culled = 0, local_bas = 0,
       local_bas_discarded = 0;
   int local_bas_cut_short = 0;  // stopped early because a newer keyframe was waiting
+  MappingStageMs ms;
 };
 
 class LocalMapper {
