@@ -16,6 +16,7 @@
 #include "common/error.hpp"
 #include "eval/scale_precision.hpp"
 #include "eval/scale_step.hpp"
+#include "eval/stretch_errors.hpp"
 #include "eval/trajectory_error.hpp"
 #include "eval/trajectory_plot.hpp"
 #include "core/features/orb_extractor.hpp"
@@ -95,7 +96,11 @@ void addEvalCommand(CLI::App& app) {
   auto ate = std::make_shared<Common>();
   auto* ate_cmd = eval->add_subcommand("ate", "Absolute trajectory error (evo_ape -as equivalent)");
   addCommon(ate_cmd, *ate);
-  ate_cmd->callback([ate]() {
+  auto stretches = std::make_shared<int>(0);
+  ate_cmd->add_option("--stretches", *stretches,
+                      "Also cut the run into N equal stretches of time: each one's mean error and own Sim3 scale")
+      ->check(CLI::Range(1, 1000));
+  ate_cmd->callback([ate, stretches]() {
     const Loaded l = load(*ate);
     const auto r = eval::computeAte(l.gt, l.est, l.match);
     if (!ate->plot.empty())
@@ -106,12 +111,23 @@ void addEvalCommand(CLI::App& app) {
       j["alignment"] = eval::toString(l.match.alignment);
       j["scale"] = r.pair.alignment.scale;
       j["reference_length"] = r.reference_length;
+      if (*stretches > 0) {
+        j["stretches"] = nlohmann::json::array();
+        for (const auto& s : eval::stretchErrors(r, *stretches))
+          j["stretches"].push_back({{"from", s.from}, {"to", s.to}, {"poses", s.poses}, {"mean_error", s.mean_error},
+                                    {"scale", s.scale}});
+      }
       fmt::print("{}\n", j.dump(2));
       return;
     }
     printStats(fmt::format("ATE, translation part ({} alignment, scale {:.6f})", eval::toString(l.match.alignment),
                            r.pair.alignment.scale),
                r.stats, "m");
+    if (*stretches > 0) {
+      fmt::print("{:>16}  {:>6}  {:>12}  {:>12}\n", "stretch (s)", "poses", "mean error", "own scale");
+      for (const auto& s : eval::stretchErrors(r, *stretches))
+        fmt::print("{:>7.1f} - {:>6.1f}  {:>6}  {:>10.4f} m  {:>12.4f}\n", s.from, s.to, s.poses, s.mean_error, s.scale);
+    }
   });
 
   auto rpe = std::make_shared<Common>();

@@ -5,6 +5,7 @@
 #include "common/error.hpp"
 #include "eval/scale_precision.hpp"
 #include "eval/scale_step.hpp"
+#include "eval/stretch_errors.hpp"
 
 namespace hiveslam::eval {
 namespace {
@@ -23,6 +24,28 @@ io::Trajectory lPath() {
     t.add(100.0 + s, at(s <= 10 ? Eigen::Vector3d(0.3 * s, 0, 1) : Eigen::Vector3d(3, 0.3 * (s - 10), 1)));
   }
   return t;
+}
+
+// A run whose first quarter came out at twice the size of the rest (a young map rescaled): the
+// stretches' own scales say so, and the error sits in them.
+TEST(StretchErrors, ShowWhereAYoungMapsScaleJumps) {
+  const io::Trajectory truth = lPath();
+  const Eigen::Matrix3d R = Eigen::AngleAxisd(0.4, Eigen::Vector3d(0, 1, 1).normalized()).toRotationMatrix();
+  io::Trajectory est;
+  const Eigen::Vector3d knee = truth.poses[50].translation();  // 5 s in
+  for (size_t i = 0; i < truth.size(); ++i) {
+    Eigen::Vector3d p = truth.poses[i].translation();
+    p = i < 50 ? knee + 2.0 * (p - knee) : p;  // the first 5 s twice as large
+    est.add(truth.stamps[i], at(3.0 * (R * p)));  // the whole map at 3x
+  }
+  const auto ate = computeAte(truth, est);
+  const auto stretches = stretchErrors(ate, 4);
+  ASSERT_EQ(stretches.size(), 4u);
+  EXPECT_EQ(stretches[0].poses + stretches[1].poses + stretches[2].poses + stretches[3].poses, truth.size());
+  EXPECT_NEAR(stretches[0].scale, 1.0 / 6.0, 1e-3);  // reference metres per estimate unit
+  for (size_t k = 1; k < 4; ++k) EXPECT_NEAR(stretches[k].scale, 1.0 / 3.0, 1e-3) << k;
+  EXPECT_GT(stretches[0].mean_error, 2 * stretches[2].mean_error);
+  EXPECT_THROW(stretchErrors(ate, 0), InputError);
 }
 
 TEST(ScaleStep, MeasuresTheStepOfAPathScaledAfterItsTurn) {

@@ -1,0 +1,23 @@
+#pragma once
+// Where in a run the error sits: the run cut into equal stretches of time, each with its mean
+// position error under the one alignment of the whole run, and the scale of a Sim3 fitted to the
+// stretch alone (reference metres per estimate unit). A monocular map with a steady scale gives
+// the same scale in every stretch; drift changes it slowly, a young map rescaled in its first
+// seconds shows a jump between the first stretches and the rest.
+#include <vector>
+
+#include "eval/trajectory_error.hpp"
+
+namespace hiveslam::eval {
+
+struct Stretch {
+  double from = 0, to = 0;  // seconds from the reference's first matched stamp
+  size_t poses = 0;
+  double mean_error = 0;    // metres, under the whole run's alignment
+  double scale = 0;         // of the stretch's own Sim3 alignment; 0 with fewer than 3 poses
+};
+
+// `ate` as computeAte returns it. Throws InputError for fewer than 1 stretch.
+std::vector<Stretch> stretchErrors(const AteResult& ate, int stretches);
+
+}  // namespace hiveslam::eval
