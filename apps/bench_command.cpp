@@ -23,12 +23,26 @@ namespace {
 
 double mbps(const nlohmann::json& j) { return j.is_object() ? j.value("bandwidth_mbps", 0.0) : 0.0; }
 
+// A count the node hosting loop closing keeps (LC, else LM, else TR).
+int fromLoopClosing(const ClusterResult& result, const char* key) {
+  for (const char* task : {"lc", "lm", "tr"})
+    if (result.reports.count(task)) return result.reports.at(task).value(key, 0);
+  return 0;
+}
+
 }  // namespace
+
+std::pair<std::string, std::string> splitSequence(const std::string& arg) {
+  const auto colon = arg.rfind(':');
+  if (colon == std::string::npos || colon == 0) return {arg, ""};
+  return {arg.substr(0, colon), arg.substr(colon + 1)};
+}
 
 nlohmann::json runBench(const BenchOptions& o) {
   nlohmann::json all = nlohmann::json::array();
   const std::filesystem::path out(o.out);
-  for (const auto& seq : o.sequences) {
+  for (const auto& arg : o.sequences) {
+    const auto [seq, own_config] = splitSequence(arg);
     const std::string name = std::filesystem::path(seq).filename().string();
     std::vector<BenchRow> rows(o.nodes.size());
     for (size_t i = 0; i < o.nodes.size(); ++i) {
@@ -48,10 +62,11 @@ nlohmann::json runBench(const BenchOptions& o) {
         c.out = (out / name / fmt::format("{}node_run{}", nodes, r + 1)).string();
         c.realtime = o.realtime;
         c.feed_topic = o.feed_topic;
-        c.config = o.config;
+        c.config = own_config.empty() ? o.config : own_config;
         fmt::print(stderr, "bench: {} {}-node run {}/{}\n", name, nodes, r + 1, o.repeats);
         const auto result = runCluster(c);
         const auto& tr = result.reports.at("tr");
+        row.ground_truth = tr.contains("ate");
         row.ate.push_back(tr.contains("ate") ? tr["ate"]["rmse"].get<double>() : -1);
         row.ate_percent.push_back(tr.contains("ate") ? tr["ate"]["percent_of_path"].get<double>() : -1);
         row.fails.push_back(tr.value("failures", 0));
@@ -64,9 +79,13 @@ nlohmann::json runBench(const BenchOptions& o) {
         row.kf_hz.push_back(tr.value("keyframe_msgs_hz", 0.0));
         row.map_hz.push_back(tr.value("map_msgs_hz", 0.0));
         row.maps.push_back(tr.value("maps", 0));
-        row.loops.push_back(result.reports.count("lc") ? result.reports.at("lc").value("loops", 0)
-                            : result.reports.count("lm") ? result.reports.at("lm").value("loops", 0)
-                                                         : tr.value("loops", 0));
+        row.loops.push_back(fromLoopClosing(result, "loops"));
+        row.merges.push_back(fromLoopClosing(result, "merges"));
+        const auto sizes = tr.value("map_keyframes", std::vector<int>{});
+        row.maps_2kf.push_back(static_cast<double>(std::count_if(sizes.begin(), sizes.end(), [](int n) { return n >= 2; })));
+        const double frames = std::max(tr.value("frames", 1), 1);
+        row.deferred.push_back(100.0 * tr.value("keyframes_deferred", 0) / frames);
+        row.dropped.push_back(100.0 * tr.value("dropped_frames", 0) / frames);
       }
     }
     for (const auto& row : rows) all.push_back(row.toJson());
@@ -77,18 +96,24 @@ nlohmann::json runBench(const BenchOptions& o) {
 }
 
 std::string benchTable(const nlohmann::json& rows) {
-  std::string t = fmt::format("{:<12} {:>5} {:>16} {:>8} {:>6} {:>9} {:>7} {:>7} {:>16} {:>11} {:>5} {:>4}\n", "sequence",
-                              "nodes", "ATE m (med/max)", "ATE %", "fails", "TR CPU s", "TR CPU%", "tracked",
-                              "BW TR/LM/LC", "KF/Map Hz", "loops", "maps");
+  std::string t = fmt::format("{:<12} {:>5} {:>16} {:>8} {:>6} {:>9} {:>7} {:>7} {:>16} {:>11} {:>5} {:>6} {:>4} {:>8} {:>7}\n",
+                              "sequence", "nodes", "ATE m (med/max)", "ATE %", "fails", "TR CPU s", "TR CPU%", "tracked",
+                              "BW TR/LM/LC", "KF/Map Hz", "loops", "merges", "maps", "deferred", "dropped");
   for (const auto& r : rows) {
-    auto m = [&](const char* k) { return r.at(k).at("median").get<double>(); };
-    t += fmt::format("{:<12} {:>5} {:>7.4f}/{:<8.4f} {:>8.3f} {:>6.1f} {:>9.1f} {:>7.1f} {:>6.1f}% {:>5.1f}/{:>4.1f}/{:>4.1f} {:>5.1f}/{:<5.1f} {:>5.1f} {:>4.0f}\n",
-                     r.at("sequence").get<std::string>(), r.at("nodes").get<int>(), m("ate"), r.at("ate").at("max").get<double>(),
-                     m("ate_percent"), m("fails"), m("cpu_seconds"), m("cpu_percent"), m("tracked"), m("bw_tr"),
-                     m("bw_lm"), m("bw_lc"), m("kf_hz"), m("map_hz"), m("loops"), r.at("maps").at("max").get<double>());
+    auto m = [&](const char* k) { return r.contains(k) ? r.at(k).at("median").get<double>() : 0.0; };
+    auto max = [&](const char* k) { return r.contains(k) ? r.at(k).at("max").get<double>() : 0.0; };
+    const bool truth = r.value("ground_truth", true);
+    const std::string ate = truth ? fmt::format("{:>7.4f}/{:<8.4f}", m("ate"), max("ate")) : fmt::format("{:>16}", "-");
+    const std::string ate_percent = truth ? fmt::format("{:>8.3f}", m("ate_percent")) : fmt::format("{:>8}", "-");
+    t += fmt::format("{:<12} {:>5} {} {} {:>6.1f} {:>9.1f} {:>7.1f} {:>6.1f}% {:>5.1f}/{:>4.1f}/{:>4.1f} {:>5.1f}/{:<5.1f} {:>5.1f} {:>6.1f} {:>4.0f} {:>7.1f}% {:>6.1f}%\n",
+                     r.at("sequence").get<std::string>(), r.at("nodes").get<int>(), ate, ate_percent, m("fails"),
+                     m("cpu_seconds"), m("cpu_percent"), m("tracked"), m("bw_tr"), m("bw_lm"), m("bw_lc"), m("kf_hz"),
+                     m("map_hz"), m("loops"), m("merges"), max("maps"), max("deferred"), max("dropped"));
   }
-  t += "medians over the runs; BW in Mbps (both directions) at each node; rates of the keyframe and map messages at TR;\n"
-       "maps: the most maps TR ended a run with (more than 1: a merge did not reach it, and ATE covers the largest only)\n";
+  t += "medians over the runs (maps, deferred and dropped: the most of any run); BW in Mbps (both directions) at each node;\n"
+       "rates of the keyframe and map messages at TR; maps: the most maps TR ended a run with (more than 1: a merge did not\n"
+       "reach it, and ATE covers the largest only); deferred: frames at which a keyframe waited for mapping; dropped: frames\n"
+       "real time skipped; both in % of the frames; ATE '-': the sequence has no ground truth\n";
   return t;
 }
 
@@ -102,6 +127,7 @@ std::string benchRules(const nlohmann::json& rows) {
     if (!by_name.count(name)) order.push_back(name);
     auto& s = by_name[name];
     s.sequence = name;
+    s.ground_truth = r.value("ground_truth", true);
     auto& c = nodes == 1 ? s.one_node : s.three_nodes;
     c.ate_m = r.at("ate").at("runs").get<std::vector<double>>();
     c.tr_cpu_seconds = r.at("cpu_seconds").at("runs").get<std::vector<double>>();
@@ -119,17 +145,20 @@ nlohmann::json BenchRow::toJson() const {
     const auto s = eval::summarize(v);
     return nlohmann::json{{"median", s.median}, {"max", s.max}, {"runs", v}};
   };
-  return {{"sequence", sequence}, {"nodes", nodes},        {"ate", stat(ate)},
+  return {{"sequence", sequence}, {"nodes", nodes}, {"ground_truth", ground_truth}, {"ate", stat(ate)},
           {"ate_percent", stat(ate_percent)}, {"fails", stat(fails)}, {"tracked", stat(tracked)},
           {"cpu_seconds", stat(cpu_seconds)}, {"cpu_percent", stat(cpu_percent)}, {"bw_tr", stat(bw_tr)},
           {"bw_lm", stat(bw_lm)}, {"bw_lc", stat(bw_lc)}, {"kf_hz", stat(kf_hz)}, {"map_hz", stat(map_hz)},
-          {"loops", stat(loops)}, {"maps", stat(maps)}};
+          {"loops", stat(loops)}, {"maps", stat(maps)}, {"merges", stat(merges)}, {"maps_2kf", stat(maps_2kf)},
+          {"deferred", stat(deferred)}, {"dropped", stat(dropped)}};
 }
 
 void addBenchCommand(CLI::App& app) {
   auto* cmd = app.add_subcommand("bench", "The paper's protocol: 1-node and 3-node runs, N repeats, a table");
   auto o = std::make_shared<BenchOptions>();
-  cmd->add_option("SEQUENCES", o->sequences, "Datasets (what `hiveslam run` reads)")->required();
+  cmd->add_option("SEQUENCES", o->sequences,
+                  "Datasets (what `hiveslam run` reads), each as PATH or PATH:SETTINGS.yaml (its own settings)")
+      ->required();
   cmd->add_option("--out", o->out, "Output folder")->required();
   cmd->add_option("--repeats", o->repeats, "Runs per sequence and configuration")->capture_default_str();
   cmd->add_option("--nodes", o->nodes, "Configurations (node counts)")->delimiter(',')->capture_default_str();

@@ -29,6 +29,7 @@ struct ConfigRuns {
 struct SequenceRuns {
   std::string sequence;
   ConfigRuns one_node, three_nodes;
+  bool ground_truth = true;  // without it only the CPU and bandwidth rules apply
 };
 
 struct RuleCheck {

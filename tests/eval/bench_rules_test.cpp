@@ -35,6 +35,15 @@ TEST(BenchRules, ABenchWithinEveryRuleHoldsThemAll) {
   EXPECT_NEAR(find(checks, "TR bandwidth").value, 3.0, 1e-9);
 }
 
+TEST(BenchRules, ASequenceWithoutGroundTruthIsJudgedOnCpuAndBandwidthOnly) {
+  SequenceRuns s = sequence({-1, -1, -1, -1, -1}, {-1, -1, -1, -1, -1});
+  s.ground_truth = false;
+  const auto checks = checkBenchRules({s});
+  ASSERT_EQ(checks.size(), 2u);
+  EXPECT_TRUE(find(checks, "TR CPU").holds);
+  EXPECT_TRUE(find(checks, "TR bandwidth").holds);
+}
+
 TEST(BenchRules, OneRunAboveOneAndAHalfTimesTheMedianFailsItsConfigurationOnly) {
   const auto checks = checkBenchRules({sequence({.006, .006, .006, .006, .006}, {.006, .006, .006, .006, .0091})});
   EXPECT_TRUE(find(checks, "outliers 1-node").holds);
