@@ -38,7 +38,7 @@ void addSynthCommand(CLI::App& app) {
   auto out = std::make_shared<std::string>();
   auto size = std::make_shared<std::string>("752x480");
   auto suite_name = std::make_shared<std::string>();
-  cmd->add_option("--trajectory", o->trajectory, "loop | figure8 | blackout | sweep | bigloop")->capture_default_str();
+  cmd->add_option("--trajectory", o->trajectory, "loop | figure8 | blackout | sweep | bigloop | handheld")->capture_default_str();
   cmd->add_option("--seed", o->seed, "Varies textures, scene layout and the exact path")->capture_default_str();
   cmd->add_option("--frames", o->frames, "Number of frames")->capture_default_str()->check(CLI::Range(2, 1000000));
   cmd->add_option("--size", *size, "Image size WxH")->capture_default_str();
@@ -48,12 +48,19 @@ void addSynthCommand(CLI::App& app) {
   cmd->add_option("--noise", o->noise, "Sensor noise sigma in grey levels")->capture_default_str();
   cmd->add_flag("--motion-blur", o->motion_blur, "Motion blur over a 10 ms exposure");
   cmd->add_flag("--exposure-changes", o->exposure_changes, "Slow exposure (gain) changes");
+  cmd->add_flag("--realistic", o->realistic,
+                "A furnished, lamp-lit room seen by a consumer camera: lens off its nominal calibration, motion blur, "
+                "rolling shutter, auto exposure, vignetting, JPEG");
+  cmd->add_option("--exposure-ms", o->exposure_ms, "With --realistic: exposure time (default 20)");
+  cmd->add_option("--readout-ms", o->readout_ms, "With --realistic: rolling shutter readout, 0 for a global shutter (default 25)");
+  cmd->add_option("--tremor-deg", o->tremor_deg, "With --realistic: the hand's tremor, 0 for none (default 0.3)");
+  cmd->add_flag("!--exact-lens", o->lens_error, "With --realistic: the images made with the nominal lens of sensor.yaml");
   cmd->add_option("--threads", o->threads, "Render threads (0: all cores)")->capture_default_str();
-  cmd->add_option("--suite", *suite_name, "Render a named suite instead (standard)");
+  cmd->add_option("--suite", *suite_name, "Render a named suite instead (standard | realistic)");
   cmd->add_option("--out", *out, "Output folder")->required();
   cmd->callback([=]() {
     if (!suite_name->empty()) {
-      for (auto entry : synth::suite(*suite_name)) {
+      for (auto entry : synth::suite(*suite_name, o->textures)) {
         entry.options.threads = o->threads;
         render(entry.options, std::filesystem::path(*out) / entry.name, entry.name);
       }

@@ -65,6 +65,7 @@ CameraPath::CameraPath(const std::vector<Waypoint>& waypoints, double duration, 
   }
   std::mt19937 rng(seed);
   for (double& p : phase_) p = std::uniform_real_distribution<double>(0, 2 * M_PI)(rng);
+  for (double& p : tremor_phase_) p = std::uniform_real_distribution<double>(0, 2 * M_PI)(rng);
 }
 
 namespace {
@@ -115,9 +116,21 @@ Eigen::Isometry3d CameraPath::pose(double t) const {
   const double pitch = wobble_ * 0.5 * (std::sin(0.7 * t + phase_[2]) + std::sin(1.9 * t + phase_[3]));
   R = R * Eigen::AngleAxisd(roll, Eigen::Vector3d::UnitZ()).toRotationMatrix() *
       Eigen::AngleAxisd(pitch, Eigen::Vector3d::UnitX()).toRotationMatrix();
+  Eigen::Vector3d shake = Eigen::Vector3d::Zero(), turn = Eigen::Vector3d::Zero();
+  if (tremor_rad_ > 0 || tremor_m_ > 0) {
+    // Per axis, three sines at 1.3-4.9 Hz whose amplitudes sum to the tremor's.
+    static constexpr double kHz[3][3] = {{1.3, 2.9, 4.7}, {1.7, 3.1, 4.9}, {1.1, 2.3, 4.1}};
+    for (int a = 0; a < 3; ++a)
+      for (int k = 0; k < 3; ++k) {
+        const double w = std::sin(2 * M_PI * kHz[a][k] * t + tremor_phase_[3 * a + k]) / 3.0;
+        turn[a] += tremor_rad_ * w;
+        shake[a] += tremor_m_ * std::sin(2 * M_PI * kHz[2 - a][k] * 0.7 * t + tremor_phase_[(3 * a + k + 4) % 12]) / 3.0;
+      }
+  }
+  if (turn.norm() > 0) R = R * Eigen::AngleAxisd(turn.norm(), turn.normalized()).toRotationMatrix();
   Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
   T.linear() = R;
-  T.translation() = eye;
+  T.translation() = eye + shake;
   return T;
 }
 

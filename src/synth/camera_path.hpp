@@ -3,6 +3,7 @@
 // through look-at targets, travelled at a speed profile that starts and ends at rest, plus a
 // small deterministic hand-held wobble in roll and pitch.
 #include <Eigen/Geometry>
+#include <cmath>
 #include <vector>
 
 namespace hiveslam::synth {
@@ -36,6 +37,12 @@ class CameraPath {
   double paramAt(double t) const { return paramAtEffort(effortAtTime(t)); }
   double duration() const { return duration_; }
   double length() const { return length_; }
+  // A hand's tremor on top of the wobble: a few tenths of a degree and a few millimetres at
+  // 1-5 Hz, sums of sines with incommensurate frequencies (0: none).
+  void setTremor(double degrees, double metres) {
+    tremor_rad_ = degrees * M_PI / 180.0;
+    tremor_m_ = metres;
+  }
   // Eye positions sampled densely, to keep obstacles off the path.
   std::vector<Eigen::Vector3d> samples(double spacing) const;
 
@@ -51,6 +58,8 @@ class CameraPath {
   double effort_ = 0.0;
   double duration_, length_ = 0.0, wobble_;
   double phase_[4];
+  double tremor_rad_ = 0.0, tremor_m_ = 0.0;
+  double tremor_phase_[12];
 };
 
 }  // namespace hiveslam::synth

@@ -6,12 +6,17 @@ namespace hiveslam::synth {
 
 void renderRadiance(const Scene& scene, const RayTable& rays, const Eigen::Isometry3d& T_wc,
                     cv::Mat& radiance, cv::Mat* depth) {
+  renderRadiance(scene, rays, std::vector<Eigen::Isometry3d>{T_wc}, radiance, depth);
+}
+
+void renderRadiance(const Scene& scene, const RayTable& rays, const std::vector<Eigen::Isometry3d>& T_wc_rows,
+                    cv::Mat& radiance, cv::Mat* depth) {
   radiance.create(rays.height, rays.width, CV_32F);
   if (depth) depth->create(rays.height, rays.width, CV_32F);
-  const Eigen::Matrix3d R = T_wc.linear();
-  const Eigen::Vector3d origin = T_wc.translation();
-  const Eigen::Vector3d light = Eigen::Vector3d(0.3, 0.5, 0.81).normalized();
   for (int v = 0; v < rays.height; ++v) {
+    const Eigen::Isometry3d& T_wc = T_wc_rows[T_wc_rows.size() == 1 ? 0 : static_cast<size_t>(v)];
+    const Eigen::Matrix3d R = T_wc.linear();
+    const Eigen::Vector3d origin = T_wc.translation();
     float* out = radiance.ptr<float>(v);
     float* dout = depth ? depth->ptr<float>(v) : nullptr;
     for (int u = 0; u < rays.width; ++u) {
@@ -41,7 +46,7 @@ void renderRadiance(const Scene& scene, const RayTable& rays, const Eigen::Isome
       }
       const float albedo = scene.textures[static_cast<size_t>(hit->texture)].sample(
           hit->u, hit->v, minor, major, du, dv);
-      const double shade = 0.72 + 0.28 * std::abs(hit->normal.dot(light));
+      const double shade = scene.shading(origin + hit->t * d, hit->normal);
       out[u] = static_cast<float>(albedo * shade);
       if (dout) dout[u] = static_cast<float>(hit->t);
     }

@@ -4,6 +4,8 @@
 #include <cmath>
 #include <limits>
 
+#include "synth/furnished_room.hpp"
+
 namespace hiveslam::synth {
 
 namespace {
@@ -20,7 +22,7 @@ struct BoxRay {
 };
 BoxRay toBox(const Box& b, const Eigen::Vector3d& o, const Eigen::Vector3d& d) {
   const double c = b.cos_yaw, s = b.sin_yaw;
-  const Eigen::Vector3d rel(o.x() - b.center.x(), o.y() - b.center.y(), o.z() - b.half.z());
+  const Eigen::Vector3d rel(o.x() - b.center.x(), o.y() - b.center.y(), o.z() - b.midHeight());
   return {{c * rel.x() + s * rel.y(), -s * rel.x() + c * rel.y(), rel.z()},
           {c * d.x() + s * d.y(), -s * d.x() + c * d.y(), d.z()}};
 }
@@ -58,6 +60,21 @@ double pillarEntry(const Pillar& p, const Eigen::Vector3d& o, const Eigen::Vecto
 
 }  // namespace
 
+double Scene::shading(const Eigen::Vector3d& p, const Eigen::Vector3d& n) const {
+  if (lights.empty()) {
+    const Eigen::Vector3d light = Eigen::Vector3d(0.3, 0.5, 0.81).normalized();
+    return 0.72 + 0.28 * std::abs(n.dot(light));
+  }
+  double e = ambient;
+  for (const Light& l : lights) {
+    const Eigen::Vector3d d = l.position - p;
+    const double d2 = std::max(d.squaredNorm(), 0.04);
+    const double cosine = n.dot(d) / std::sqrt(d2);
+    if (cosine > 0) e += l.power * cosine / d2;
+  }
+  return e;
+}
+
 void Box::setYaw(double yaw) {
   cos_yaw = std::cos(yaw);
   sin_yaw = std::sin(yaw);
@@ -83,7 +100,7 @@ std::optional<Hit> Scene::intersect(const Eigen::Vector3d& o, const Eigen::Vecto
   for (size_t k = 0; k < boxes.size(); ++k) {
     // Bounding-sphere rejection first: most rays miss most boxes.
     const Box& b = boxes[k];
-    const Eigen::Vector3d w(b.center.x() - o.x(), b.center.y() - o.y(), b.half.z() - o.z());
+    const Eigen::Vector3d w(b.center.x() - o.x(), b.center.y() - o.y(), b.midHeight() - o.z());
     const double wd = w.dot(d);
     const double r2 = b.half.squaredNorm();
     if (wd < 0 && w.squaredNorm() > r2) continue;  // behind the ray origin
@@ -159,7 +176,7 @@ bool Scene::isFree(const Eigen::Vector3d& p, double clearance) const {
   for (const Box& b : boxes) {
     const double c = b.cos_yaw, s = b.sin_yaw;
     const double rx = p.x() - b.center.x(), ry = p.y() - b.center.y();
-    const Eigen::Vector3d l(c * rx + s * ry, -s * rx + c * ry, p.z() - b.half.z());
+    const Eigen::Vector3d l(c * rx + s * ry, -s * rx + c * ry, p.z() - b.midHeight());
     const Eigen::Vector3d outside = (l.cwiseAbs() - b.half).cwiseMax(0.0);
     if (outside.norm() < clearance) return false;
   }
@@ -180,6 +197,10 @@ Scene makeScene(const SceneOptions& o, const std::vector<Eigen::Vector3d>& keep_
       if (!s.isFree(p, kClearance)) return false;
     return true;
   };
+  if (o.furnished) {
+    furnishRoom(scene, o, pathClear, rng);
+    return scene;
+  }
   const Eigen::Vector3d inner = o.room_size / 2 - Eigen::Vector3d::Constant(0.5);
   for (int i = 0, tries = 0; i < o.boxes && tries < 400; ++tries) {
     Box b;

@@ -13,12 +13,14 @@
 namespace hiveslam::synth {
 
 struct Box {
-  Eigen::Vector2d center;   // on the floor
-  Eigen::Vector3d half;     // half sizes along its own axes; it rises from z = 0 to 2 half.z
+  Eigen::Vector2d center;   // of its footprint
+  Eigen::Vector3d half;     // half sizes along its own axes; it rises from z = base to base + 2 half.z
+  double base = 0.0;        // height of its bottom face (a table top stands on legs)
   int texture = 0;          // first of its 6 face textures: -x +x -y +y -z +z
   // Rotation about z, kept as cosine and sine: every ray needs them.
   double cos_yaw = 1.0, sin_yaw = 0.0;
   void setYaw(double yaw);
+  double midHeight() const { return base + half.z(); }
 };
 
 struct Pillar {
@@ -35,11 +37,24 @@ struct Hit {
   Eigen::Vector3d axis_u, axis_v;  // surface directions of increasing u and v
 };
 
+// A lamp: irradiance power / d^2 on surfaces facing it (no shadows).
+struct Light {
+  Eigen::Vector3d position;
+  double power = 1.0;
+};
+
 struct Scene {
   Eigen::Vector3d room_min, room_max;  // inside of the room
   std::vector<Box> boxes;
   std::vector<Pillar> pillars;
   std::vector<Texture> textures;  // room faces first: -x +x -y +y floor ceiling
+  // Without lights, one distant light and a constant ambient term; with them, the shading of
+  // each point adds up the lamps, so the brightness varies across the room.
+  std::vector<Light> lights;
+  double ambient = 0.0;  // irradiance every surface gets with lights on
+
+  // How much light a point with (unit, ray-facing) normal n receives: about 1 on average.
+  double shading(const Eigen::Vector3d& p, const Eigen::Vector3d& n) const;
 
   // Nearest surface along origin + t dir with t > 0; nullopt only for rays that leave the room
   // (impossible from inside).
@@ -50,6 +65,10 @@ struct Scene {
 
 struct SceneOptions {
   Eigen::Vector3d room_size{10.0, 8.0, 3.0};
+  // A lived-in room instead of the textured box: plain painted walls and ceiling with a few
+  // pictures, a low-contrast floor, tables with objects on them, shelves, cupboards and boxes
+  // textured from `photos` (procedural where none), lit by ceiling lamps.
+  bool furnished = false;
   int boxes = 6;
   int pillars = 3;
   double texel_density = 300.0;        // texels per metre

@@ -23,8 +23,10 @@ namespace {
 
 constexpr int64_t kStartNs = 1'000'000'000'000;  // 1000 s: EuRoC-like stamps, exact in ns
 
-Eigen::Vector3d roomSize(std::mt19937_64& rng) {
+Eigen::Vector3d roomSize(std::mt19937_64& rng, bool furnished) {
   auto uni = [&](double a, double b) { return std::uniform_real_distribution<double>(a, b)(rng); };
+  // A furnished room is an office or a living room; the textured box room is a hall.
+  if (furnished) return {uni(5.0, 6.5), uni(4.0, 5.2), uni(2.5, 2.8)};
   return {uni(8.5, 11.5), uni(6.5, 8.5), uni(2.8, 3.4)};
 }
 
@@ -37,14 +39,50 @@ SequenceModel buildSequence(const SequenceOptions& o) {
   // Separate streams for layout, path and textures keep one from shifting the others.
   std::mt19937_64 layout_rng(o.seed * 7919 + 1), path_rng(o.seed * 7919 + 2), scene_rng(o.seed * 7919 + 3);
   SceneOptions scene_options;
-  scene_options.room_size = roomSize(layout_rng);
+  scene_options.room_size = roomSize(layout_rng, o.realistic);
+  scene_options.furnished = o.realistic;
   if (!o.textures.empty()) scene_options.photos = loadPhotos(o.textures);
   TrajectoryPlan plan = planTrajectory(o.trajectory, scene_options.room_size, path_rng);
   const double duration = (o.frames - 1) / o.fps;
   CameraPath path(plan.waypoints, duration, 0.03, static_cast<unsigned>(o.seed));
+  if (o.realistic) path.setTremor(o.tremor_deg >= 0 ? o.tremor_deg : 0.3, o.tremor_deg == 0 ? 0.0 : 0.002);
   Scene scene = makeScene(scene_options, path.samples(0.1), scene_rng);
-  return SequenceModel{o, Lens::standard(o.width, o.height, o.distortion), std::move(scene),
-                       std::move(path), std::move(plan)};
+  Lens lens = Lens::standard(o.width, o.height, o.distortion);
+  Imaging imaging;
+  if (o.realistic) {
+    // A Kinect-like 62 x 48 degree field of view: fx 525 at 640 pixels.
+    lens.fx = lens.fy = 525.0 * o.width / 640.0;
+    imaging = Imaging::realistic();
+    if (o.exposure_ms >= 0) imaging.exposure_s = o.exposure_ms / 1000.0;
+    if (o.readout_ms >= 0) imaging.readout_s = o.readout_ms / 1000.0;
+    if (!o.lens_error) {
+      imaging.focal_error = imaging.hidden_k1 = 0;
+      imaging.principal_error_px[0] = imaging.principal_error_px[1] = 0;
+    }
+  } else if (o.motion_blur) {
+    imaging.exposure_s = 0.010;
+    imaging.max_sub_frames = 5;
+  }
+  SequenceModel model{o, lens, imaging.trueLens(lens), std::move(scene), std::move(path), std::move(plan), imaging,
+                      {}, imaging.vignette(o.width, o.height)};
+  if (imaging.auto_exposure) {
+    // What the camera's metering sees: each frame at an eighth of the resolution, unit gain.
+    Lens small = model.true_lens;
+    small.width = std::max(8, o.width / 8);
+    small.height = std::max(8, o.height / 8);
+    small.fx /= 8.0, small.fy /= 8.0, small.cx = (small.cx + 0.5) / 8.0 - 0.5, small.cy = (small.cy + 0.5) / 8.0 - 0.5;
+    const RayTable rays(small);
+    std::vector<double> means(static_cast<size_t>(o.frames));
+    cv::Mat radiance;
+    for (int f = 0; f < o.frames; ++f) {
+      renderRadiance(model.scene, rays, model.pose(f), radiance);
+      means[static_cast<size_t>(f)] = model.blank(f) ? imaging.target_mean : cv::mean(radiance)[0];
+    }
+    model.gains = imaging.gains(means, o.fps);
+  } else {
+    model.gains.assign(static_cast<size_t>(o.frames), 1.0);
+  }
+  return model;
 }
 
 double SequenceModel::stamp(int frame) const { return static_cast<double>(stampNs(frame)) / 1e9; }
@@ -66,36 +104,39 @@ cv::Mat SequenceModel::renderImage(int frame, const RayTable& rays) const {
   cv::Mat radiance(rays.height, rays.width, CV_32F, cv::Scalar(0));
   const double t = frame / options.fps;
   if (!blank(frame)) {
-    if (options.motion_blur) {
-      // A 10 ms exposure centred on the stamp, 5 sub-frames.
-      constexpr int kSub = 5;
-      cv::Mat sub;
-      for (int k = 0; k < kSub; ++k) {
-        renderRadiance(scene, rays, path.pose(t + 0.010 * ((k + 0.5) / kSub - 0.5)), sub);
-        radiance += sub / kSub;
-      }
-    } else {
-      renderRadiance(scene, rays, path.pose(t), radiance);
+    // Sub-frames over the exposure, centred on the stamp: about one per pixel the view turns
+    // during it, at most max_sub_frames.
+    int subs = 1;
+    const double e = imaging.exposure_s;
+    if (options.motion_blur || options.realistic) {
+      const Eigen::Isometry3d a = path.pose(t - e / 2), b = path.pose(t + e / 2);
+      const double turn_px = Eigen::AngleAxisd(a.linear().transpose() * b.linear()).angle() * true_lens.fx;
+      subs = std::clamp(static_cast<int>(std::ceil(turn_px)), options.realistic ? 1 : imaging.max_sub_frames,
+                        imaging.max_sub_frames);
     }
-    if (options.exposure_changes)
+    cv::Mat sub;
+    std::vector<Eigen::Isometry3d> rows(imaging.readout_s > 0 ? static_cast<size_t>(rays.height) : 1);
+    for (int k = 0; k < subs; ++k) {
+      const double ts = subs > 1 ? t + e * ((k + 0.5) / subs - 0.5) : t;
+      // Rolling shutter: row v is exposed readout * (v / (height - 1) - 1/2) after the stamp.
+      for (size_t v = 0; v < rows.size(); ++v)
+        rows[v] = path.pose(rows.size() == 1 ? ts : ts + imaging.readout_s * (v / (rows.size() - 1.0) - 0.5));
+      renderRadiance(scene, rays, rows, sub);
+      radiance += sub / subs;
+    }
+    if (options.exposure_changes && !options.realistic)
       radiance *= 1.0 + 0.25 * std::sin(2 * M_PI * t / 17.0) * std::sin(2 * M_PI * t / 5.3 + 1.0);
   }
-  if (options.noise > 0) {
-    cv::Mat noise(radiance.size(), CV_32F);
-    cv::RNG rng(options.seed * 1000003ULL + static_cast<uint64_t>(frame));
-    rng.fill(noise, cv::RNG::NORMAL, 0.0, options.noise);
-    radiance += noise;
-  }
-  cv::Mat image;
-  radiance.convertTo(image, CV_8U);  // rounds and saturates
-  return image;
+  radiance *= gains[static_cast<size_t>(frame)];
+  if (imaging.vignetting > 0) radiance = radiance.mul(vignette);
+  return imaging.develop(radiance, options.noise, options.seed * 1000003ULL + static_cast<uint64_t>(frame));
 }
 
 SequenceSummary writeSequence(const SequenceOptions& o, const fs::path& out,
                               const std::function<void(int, int)>& progress) {
   const auto t0 = std::chrono::steady_clock::now();
   const SequenceModel model = buildSequence(o);
-  const RayTable rays(model.lens);
+  const RayTable rays(model.true_lens);
   const fs::path cam0 = out / "mav0" / "cam0";
   const fs::path gt_dir = out / "mav0" / "state_groundtruth_estimate0";
   std::error_code ec;
@@ -182,6 +223,11 @@ SequenceSummary writeSequence(const SequenceOptions& o, const fs::path& out,
                          {"noise", o.noise},
                          {"motion_blur", o.motion_blur},
                          {"exposure_changes", o.exposure_changes},
+                         {"realistic", o.realistic},
+                         {"exposure_ms", o.exposure_ms},
+                         {"readout_ms", o.readout_ms},
+                         {"tremor_deg", o.tremor_deg},
+                         {"lens_error", o.lens_error},
                          {"textures", o.textures.empty() ? "procedural" : o.textures},
                          {"room_size", {model.scene.room_max.x() * 2, model.scene.room_max.y() * 2, model.scene.room_max.z()}},
                          {"boxes", model.scene.boxes.size()},
@@ -210,6 +256,11 @@ SequenceOptions readSequenceOptions(const fs::path& dataset) {
     o.noise = info.at("noise").get<double>();
     o.motion_blur = info.at("motion_blur").get<bool>();
     o.exposure_changes = info.at("exposure_changes").get<bool>();
+    o.realistic = info.value("realistic", false);
+    o.exposure_ms = info.value("exposure_ms", -1.0);
+    o.readout_ms = info.value("readout_ms", -1.0);
+    o.tremor_deg = info.value("tremor_deg", -1.0);
+    o.lens_error = info.value("lens_error", true);
     const auto textures = info.at("textures").get<std::string>();
     if (textures != "procedural") o.textures = textures;
     return o;

@@ -8,6 +8,7 @@
 #include <string>
 
 #include "synth/camera_path.hpp"
+#include "synth/imaging.hpp"
 #include "synth/lens.hpp"
 #include "synth/scene.hpp"
 #include "synth/trajectory_plan.hpp"
@@ -25,22 +26,34 @@ struct SequenceOptions {
   double noise = 2.0;            // sensor noise sigma, grey levels
   bool motion_blur = false;      // average of sub-frames over a 10 ms exposure
   bool exposure_changes = false; // slow gain changes of up to +-25%
+  // Made to look like a hand-held consumer camera in a lived-in room (synth/imaging.hpp,
+  // synth/furnished_room.hpp): a furnished room lit by lamps, a 62-degree lens that differs from
+  // the nominal one in sensor.yaml, motion blur of a 20 ms exposure, rolling shutter, auto
+  // exposure, vignetting, shot noise and JPEG. Implies motion_blur; replaces exposure_changes.
+  bool realistic = false;
+  // Ablations of the realistic camera (negative: Imaging::realistic()'s value).
+  double exposure_ms = -1, readout_ms = -1, tremor_deg = -1;
+  bool lens_error = true;        // false: the true lens is the nominal one
   int threads = 0;               // 0: all cores
 };
 
 // Everything a sequence is made of, rebuilt deterministically from the options.
 struct SequenceModel {
   SequenceOptions options;
-  Lens lens;
+  Lens lens;       // the nominal camera, as sensor.yaml says
+  Lens true_lens;  // the one the images are made with: `lens` unless realistic
   Scene scene;
   CameraPath path;
   TrajectoryPlan plan;
+  Imaging imaging;
+  std::vector<double> gains;  // per frame: auto exposure (all 1 without it)
+  cv::Mat vignette;           // per pixel brightness factor
 
   double stamp(int frame) const;                   // seconds
   int64_t stampNs(int frame) const;
   Eigen::Isometry3d pose(int frame) const;         // T_wc at the frame's stamp
   bool blank(int frame) const;
-  // The 8-bit image of a frame with every imaging effect applied.
+  // The 8-bit image of a frame with every imaging effect applied; `rays` of true_lens.
   cv::Mat renderImage(int frame, const RayTable& rays) const;
 };
 

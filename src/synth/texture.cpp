@@ -140,7 +140,7 @@ Texture makeProceduralTexture(double width_m, double height_m, double density, s
 }
 
 Texture makePhotoTexture(double width_m, double height_m, double density,
-                         const std::vector<cv::Mat>& photos, std::mt19937_64& rng) {
+                         const std::vector<cv::Mat>& photos, std::mt19937_64& rng, double contrast) {
   const cv::Size size = texelSize(width_m, height_m, density);
   const cv::Mat& photo = photos[static_cast<size_t>(uniform(rng, 0, static_cast<double>(photos.size()))) % photos.size()];
   const double tile_m = uniform(rng, 0.8, 2.0);
@@ -160,6 +160,37 @@ Texture makePhotoTexture(double width_m, double height_m, double density,
       const int tx = (x + ox) % (2 * tw);
       out[x] = row[tx < tw ? tx : 2 * tw - 1 - tx];
     }
+  }
+  if (contrast != 1.0) {
+    const double mean = cv::mean(img)[0];
+    img.convertTo(img, CV_8U, contrast, mean * (1.0 - contrast));
+  }
+  return Texture(img, density);
+}
+
+Texture makePlainTexture(double width_m, double height_m, double density, double grey, std::mt19937_64& rng) {
+  const cv::Size size = texelSize(width_m, height_m, density);
+  // Variations of +-3% over about a metre: uneven paint and light that the lamps do not explain.
+  cv::Mat coarse(std::max(2, static_cast<int>(height_m / 1.0) + 1), std::max(2, static_cast<int>(width_m / 1.0) + 1),
+                 CV_32F);
+  for (int r = 0; r < coarse.rows; ++r)
+    for (int c = 0; c < coarse.cols; ++c) coarse.at<float>(r, c) = static_cast<float>(grey * uniform(rng, 0.97, 1.03));
+  cv::Mat base;
+  cv::resize(coarse, base, size, 0, 0, cv::INTER_CUBIC);
+  cv::Mat img;
+  base.convertTo(img, CV_8U);
+  // About one faint mark per square metre, 1-8 cm, 4-15 grey levels off the paint.
+  const int marks = static_cast<int>(width_m * height_m * 1.0);
+  for (int i = 0; i < marks; ++i) {
+    const cv::Point c(static_cast<int>(uniform(rng, 0, size.width)), static_cast<int>(uniform(rng, 0, size.height)));
+    const int r = std::max(1, static_cast<int>(density * uniform(rng, 0.005, 0.04)));
+    const double sign = uniform(rng, 0, 1) < 0.7 ? -1.0 : 1.0;
+    const cv::Scalar shade(std::clamp(grey + sign * uniform(rng, 4, 15), 0.0, 255.0));
+    if (uniform(rng, 0, 1) < 0.5)
+      cv::circle(img, c, r, shade, cv::FILLED, cv::LINE_AA);
+    else
+      cv::line(img, c, c + cv::Point(static_cast<int>(uniform(rng, -2, 2) * r), static_cast<int>(uniform(rng, -2, 2) * r)),
+               shade, std::max(1, r / 4), cv::LINE_AA);
   }
   return Texture(img, density);
 }

@@ -34,9 +34,14 @@ class Texture {
 // discs and strokes whose sizes span 3 cm to 50 cm.
 Texture makeProceduralTexture(double width_m, double height_m, double density, std::mt19937_64& rng);
 
-// A texture tiled (mirrored) from one of `photos` at a random scale and offset.
+// A texture tiled (mirrored) from one of `photos` at a random scale and offset, its contrast
+// about the mean scaled by `contrast` (below 1: a faded, low-contrast surface).
 Texture makePhotoTexture(double width_m, double height_m, double density,
-                         const std::vector<cv::Mat>& photos, std::mt19937_64& rng);
+                         const std::vector<cv::Mat>& photos, std::mt19937_64& rng, double contrast = 1.0);
+
+// Paint or laminate: one grey with slow variations of a few percent and a few faint marks
+// (scuffs, screw heads, an outline), so that large parts of it hold no corner at all.
+Texture makePlainTexture(double width_m, double height_m, double density, double grey, std::mt19937_64& rng);
 
 // Loads the images of a folder as grayscale photos (throws InputError when there are none).
 std::vector<cv::Mat> loadPhotos(const std::string& folder);

@@ -11,6 +11,7 @@
 #include "synth/sequence.hpp"
 #include "synth/suite.hpp"
 #include "temp_dir.hpp"
+#include "warp_error.hpp"
 
 namespace hiveslam::synth {
 namespace {
@@ -39,22 +40,8 @@ TEST(Sequence, GroundTruthIsConsistentWithTheImages) {
   auto warpError = [&](int i, int j, const Eigen::Isometry3d& T_wj) {
     cv::Mat radiance, depth;
     renderRadiance(model.scene, rays, gt.poses[static_cast<size_t>(i)], radiance, &depth);
-    const Eigen::Isometry3d T_ji = T_wj.inverse() * gt.poses[static_cast<size_t>(i)];
-    double sum = 0;
-    int n = 0;
-    for (int v = 5; v < o.height - 5; ++v)
-      for (int u = 5; u < o.width - 5; ++u) {
-        const Eigen::Vector3d bearing = cam.unproject(Eigen::Vector2d(u, v));
-        const Eigen::Vector3d p_i = bearing * depth.at<float>(v, u) / bearing.z();
-        Eigen::Vector2d uv;
-        if (!cam.project(T_ji * p_i, uv) || !cam.inImage(uv, 2)) continue;
-        cv::Mat patch;
-        cv::getRectSubPix(images[static_cast<size_t>(j)], {1, 1}, cv::Point2f(uv.x(), uv.y()), patch, CV_32F);
-        sum += std::abs(patch.at<float>(0, 0) - images[static_cast<size_t>(i)].at<uchar>(v, u));
-        ++n;
-      }
-    EXPECT_GT(n, 1000);
-    return sum / n;
+    return synth::warpError<uchar>(images[static_cast<size_t>(i)], depth, images[static_cast<size_t>(j)],
+                                   T_wj.inverse() * gt.poses[static_cast<size_t>(i)], cam);
   };
   const double right = warpError(100, 104, gt.poses[104]);
   const double wrong = warpError(100, 104, gt.poses[108]);
