@@ -70,7 +70,10 @@ SequenceModel buildSequence(const SequenceOptions& o) {
     Lens small = model.true_lens;
     small.width = std::max(8, o.width / 8);
     small.height = std::max(8, o.height / 8);
-    small.fx /= 8.0, small.fy /= 8.0, small.cx = (small.cx + 0.5) / 8.0 - 0.5, small.cy = (small.cy + 0.5) / 8.0 - 0.5;
+    small.fx /= 8.0;
+    small.fy /= 8.0;
+    small.cx = (small.cx + 0.5) / 8.0 - 0.5;
+    small.cy = (small.cy + 0.5) / 8.0 - 0.5;
     const RayTable rays(small);
     std::vector<double> means(static_cast<size_t>(o.frames));
     cv::Mat radiance;
@@ -104,15 +107,16 @@ cv::Mat SequenceModel::renderImage(int frame, const RayTable& rays) const {
   cv::Mat radiance(rays.height, rays.width, CV_32F, cv::Scalar(0));
   const double t = frame / options.fps;
   if (!blank(frame)) {
-    // Sub-frames over the exposure, centred on the stamp: about one per pixel the view turns
-    // during it, at most max_sub_frames.
+    // Sub-frames over the exposure, centred on the stamp. The realistic camera takes about one
+    // per pixel the view turns during it, at most max_sub_frames; --motion-blur always its 5.
     int subs = 1;
     const double e = imaging.exposure_s;
-    if (options.motion_blur || options.realistic) {
+    if (options.realistic) {
       const Eigen::Isometry3d a = path.pose(t - e / 2), b = path.pose(t + e / 2);
       const double turn_px = Eigen::AngleAxisd(a.linear().transpose() * b.linear()).angle() * true_lens.fx;
-      subs = std::clamp(static_cast<int>(std::ceil(turn_px)), options.realistic ? 1 : imaging.max_sub_frames,
-                        imaging.max_sub_frames);
+      subs = std::clamp(static_cast<int>(std::ceil(turn_px)), 1, imaging.max_sub_frames);
+    } else if (options.motion_blur) {
+      subs = imaging.max_sub_frames;
     }
     cv::Mat sub;
     std::vector<Eigen::Isometry3d> rows(imaging.readout_s > 0 ? static_cast<size_t>(rays.height) : 1);
