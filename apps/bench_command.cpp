@@ -50,7 +50,7 @@ nlohmann::json runBench(const BenchOptions& o) {
       rows[i].nodes = o.nodes[i];
     }
     // The configurations take turns, run by run: this machine's speed drifts over minutes (a
-    // bench's tracking medians moved 20% between its 1-node and its 3-node runs, session 42),
+    // bench's tracking medians moved 20% between its 1-node and its 3-node runs),
     // and the CPU rule compares the two.
     for (int r = 0; r < o.repeats; ++r) {
       for (size_t i = 0; i < o.nodes.size(); ++i) {

@@ -244,7 +244,7 @@ void DistributedNode::onLeaving(const PeerInfo& peer) {
   spdlog::info("node {}: peer {} ({}) left", options_.id, peer.name, communication::taskName(peer.task));
   // The rest waits until the packets it sent before leaving are handled. Dropped at the
   // notice, the batches still queued here of its last snapshot started a collection never
-  // completed (LC ended 71 points short, session 39). And a gateway that leaves at the end of
+  // completed (LC ended 71 points short). And a gateway that leaves at the end of
   // a run has sent its Done before its leaving notice, which can overtake it (the notice comes
   // on its own topic and is handled at once): taken as a death, TR took mapping back and LC
   // and TR sent each other their whole maps, the newcomer's reader wait holding TR 10 s past
@@ -278,7 +278,7 @@ void DistributedNode::departed(const PeerInfo& peer) {
   if (options_.task == Task::LoopClosing && peer.task == Task::Mapping) resendGlobalsToTracking();
   // TR, the gateway now that its LM left, and an LC: the keyframes LM had mapped but not yet
   // sent on to LC never reach it (LC's S_full got their records from TR's last snapshot, its
-  // SLAM map never their features: a keyframe short of TR, session 40). The newcomer's snapshot
+  // SLAM map never their features: a keyframe short of TR). The newcomer's snapshot
   // brings the features of those it lacks.
   const Plan after = plan();
   if (before.keyframes_to_lm && after.keyframes_to_lc)

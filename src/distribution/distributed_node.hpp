@@ -126,7 +126,7 @@ class DistributedNode final : public core::SystemEvents {
   // LC, once its mapping node has left: the global maps that node had not relayed yet never
   // reach TR, which maps again as the new gateway. Its maps would stay in an older epoch, and
   // LC ignores everything TR labels with that epoch, the last snapshot included (LC ended 79
-  // points short of TR, session 40). So LC sends its latest global state of each map to TR.
+  // points short of TR). So LC sends its latest global state of each map to TR.
   void resendGlobalsToTracking();
   // LC: whether `asker` is TR asking as the gateway after an LM (a TR that was the gateway all
   // along has every global map already).

@@ -38,7 +38,7 @@ void DistributedNode::onControl(const Message& m, Topic topic) {
         while (!handler_->idle()) std::this_thread::sleep_for(std::chrono::milliseconds(5));
         // A gateway that took over at the end (TR, after its LM died) began to read this topic
         // only then: a Done written before its reader matched never reaches it (TR waited its
-        // 60 s for one, session 40). Bounded: a gateway that never reads is not waited for.
+        // 60 s for one). Bounded: a gateway that never reads is not waited for.
         const auto until = std::chrono::steady_clock::now() + std::chrono::seconds(5);
         while (!transport_.peerReads(Topic::LcMap, asker) && std::chrono::steady_clock::now() < until) {
           {

@@ -29,7 +29,7 @@ struct DistributionSettings {
   // LC's global maps to its gateway, on a topic that carries nothing else: no local map waits
   // behind them there, and a merge reaches tracking only after two hops (LC's map to LM, then
   // LM's relay). Paced like the relay, a 7-batch merge took 1.5 s to reach TR on blackout, and
-  // TR tracked 230-280 points where the standalone system tracked 345-375 (session 43).
+  // TR tracked 230-280 points where the standalone system tracked 345-375.
   int lc_global_batch_gap_ms = 0;
   // How long tracking waits for the gateway to acknowledge its last keyframe as mapped: an
   // offline run waits this long at most before going on; in any run, an acknowledgement this
@@ -44,7 +44,7 @@ struct DistributionSettings {
   // longer than release_slow_gateway_ms each, none came for release_slow_acks times that long,
   // or tracking was lost with a keyframe waiting longer than that (distribution/gateway_watch).
   // 0 in either: never. Loopback acknowledgements take 25-85 ms; over a 2 Mbit/s link they
-  // took 2-50 s (docs/BENCHMARKS.md, session 41).
+  // took 2-50 s.
   int release_slow_gateway_ms = 1000;
   int release_slow_acks = 3;
   // How long a dead peer can still look present: the DDS lease (2 s) and its handling. A

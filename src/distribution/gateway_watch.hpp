@@ -2,7 +2,7 @@
 // Whether a tracking node's link to its mapping node can carry the offloading. Tracking needs
 // each keyframe's new points back within a few frames; over a link that takes seconds per
 // acknowledgement it runs out of points and loses its map (2 Mbit/s: 4 maps and 5 failures in
-// a 240-frame run, acknowledgements 2-50 s, session 41). Judged on evidence that only a slow
+// a 240-frame run, acknowledgements 2-50 s). Judged on evidence that only a slow
 // link gives: `slow_acks` acknowledgements in a row each later than `slow`; no answer at all
 // for `slow_acks` times `slow` while keyframes wait; or tracking lost while a keyframe has
 // waited longer than `slow` (over 2 Mbit/s the first map was lost 1.3 s after it began, before

@@ -235,7 +235,7 @@ void MapHandler::loop() {
       // meanwhile. A receiver drops an update it did not get whole, so one cut short for a newer
       // one is lost work, and where updates come faster than a whole map takes to send (global
       // BAs back to back on a large map: 14 batches 100 ms apart, a global BA every 1.2 s) none
-      // ever arrived: 12 in a row at the end of a 3-node bigloop run (session 33).
+      // ever arrived: 12 in a row at the end of a 3-node bigloop run.
       const int gap = g.topic == Topic::LcMap ? settings_.lc_global_batch_gap_ms : settings_.global_batch_gap_ms;
       if (g.next < g.batches.size()) globals_.push_front(std::move(g));
       next_global = Clock::now() + std::chrono::milliseconds(gap);

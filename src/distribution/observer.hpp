@@ -59,7 +59,7 @@ class Observer {
   // Global map batches being collected, by map and sender, for one epoch at a time (a newer
   // epoch drops an unfinished older one). Epochs are counted by each sender: a gateway that
   // joins gets TR's hand-over and LC's next update of the same map at once, and collected by
-  // map alone, each dropped the other's batches as those of an older update (session 22).
+  // map alone, each dropped the other's batches as those of an older update.
   std::map<std::pair<Id, uint16_t>, std::vector<MapRecord>> pending_global_;
 };
 

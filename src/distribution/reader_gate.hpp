@@ -5,7 +5,7 @@
 // match this node's writers. What goes out in between never reaches it. Most packets are
 // repaired by later ones; a new map's first keyframe is not: it carries the map (its first
 // keyframe as a companion), and the later ones only name it. One lost that way left a
-// loop-closing node holding keyframes of a map it never got (CI, session 36: a mapping node
+// loop-closing node holding keyframes of a map it never got (CI: a mapping node
 // that had just returned forwarded TR's new map to LC before LC's reader had matched).
 //
 // Which tasks read which topic from this node: keyframes from TR go to mapping nodes, mapped

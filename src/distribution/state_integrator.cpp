@@ -406,7 +406,7 @@ bool StateIntegrator::applyGlobal(const std::vector<MapRecord>& batches, bool au
   const uint64_t epoch = batches.front().epoch;
   // LC's relay, labelled with LC's latest published update, can still be older than LC's map:
   // a merge or loop correction is in the map from the moment it is made and gets its label a
-  // moment later. Taken, it erased the merged map's keyframes (CI, session 23: 11.6% ATE).
+  // moment later. Taken, it erased the merged map's keyframes (CI: 11.6% ATE).
   const auto left = [&](const core::Map& m) { return authoritative && stale(m, epoch); };
   if (auto m = slam_.findMap(batches.front().map)) {
     std::lock_guard lock(m->mutex);
@@ -514,7 +514,7 @@ bool StateIntegrator::applyGlobal(const std::vector<MapRecord>& batches, bool au
     const auto newest = newestByNode(ids), newest_keyframe = newestByNode(kf_ids);
     const auto keyframe_known = [&](Id id) { return olderThanSnapshot(id, newest_keyframe); };
     // - A point of a node that has left: all it ever sends is in (a mapping node that died
-    //   left points at LC that TR, the gateway after it, never got: one more at LC, session 40).
+    //   left points at LC that TR, the gateway after it, never got: one more at LC).
     const auto point_known = [&](Id id) {
       return olderThanSnapshot(id, newest) || departed_(core::IdGenerator::node(id));
     };

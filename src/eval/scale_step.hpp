@@ -3,7 +3,7 @@
 // Sim3-aligned onto the reference on its own, and the step is the ratio of the two scales
 // (1 when the map kept one scale; 1.01 when the second stretch came out 1% larger relative to
 // the first). On an open path it is what a single ATE alignment cannot hide: a step of 1% at
-// sweep's east turn costs about 15 mm of ATE (docs/BENCHMARKS.md, session 18).
+// sweep's east turn costs about 15 mm of ATE.
 #include <limits>
 
 #include "eval/trajectory_error.hpp"

@@ -1,5 +1,7 @@
 #include "io/camera_settings.hpp"
 
+#include <algorithm>
+
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 #include <yaml-cpp/yaml.h>
@@ -86,12 +88,22 @@ T optional(const YAML::Node& node, const std::string& key, T fallback,
 
 }  // namespace
 
+const std::vector<std::string>& cameraSettingKeys() {
+  static const std::vector<std::string> keys{"model", "width", "height", "intrinsics", "distortion", "fps"};
+  return keys;
+}
+
 bool hasCameraSection(const std::filesystem::path& path) { return static_cast<bool>(loadYaml(path)["camera"]); }
 
 CameraSettings loadSettingsCamera(const std::filesystem::path& path) {
   const YAML::Node root = loadYaml(path);
   const YAML::Node cam = root["camera"];
   if (!cam) throw InputError(path.string() + ": no 'camera' section");
+  for (const auto& kv : cam) {
+    const auto key = kv.first.as<std::string>();
+    if (std::find(cameraSettingKeys().begin(), cameraSettingKeys().end(), key) == cameraSettingKeys().end())
+      throw InputError(path.string() + ": unknown setting 'camera." + key + "'");
+  }
   // One statement per key so that the first missing key is the one reported.
   const auto model = required<std::string>(cam, "model", path);
   const int width = required<int>(cam, "width", path);

@@ -27,6 +27,9 @@ std::shared_ptr<const camera::CameraModel> makeCamera(const std::string& model, 
                                                       const std::vector<double>& distortion,
                                                       const std::string& source);
 
+// The keys of a settings file's `camera:` section; any other key there is an error.
+const std::vector<std::string>& cameraSettingKeys();
+
 CameraSettings loadSettingsCamera(const std::filesystem::path& settings_yaml);
 // Whether a settings file has a `camera:` section (one with only `slam:` settings leaves the
 // calibration to the dataset).

@@ -6,6 +6,7 @@
 #include <map>
 
 #include "common/error.hpp"
+#include "io/camera_settings.hpp"
 
 namespace hiveslam::io {
 
@@ -42,13 +43,8 @@ void apply(const std::filesystem::path& file, const YAML::Node& section, const K
   }
 }
 
-}  // namespace
-
-void applySlamSettings(const std::filesystem::path& file, core::SlamSettings& s) {
-  const YAML::Node root = load(file);
-  const YAML::Node slam = root["slam"];
-  if (!slam) return;
-  const KeyTable keys{
+KeyTable slamKeys(core::SlamSettings& s) {
+  return {
       {"init_min_matches", set(s.init_min_matches)},
       {"init_min_parallax_deg", set(s.init_min_parallax_deg)},
       {"init_min_points", set(s.init_min_points)},
@@ -91,23 +87,22 @@ void applySlamSettings(const std::filesystem::path& file, core::SlamSettings& s)
       {"vocabulary", set(s.vocabulary)},
       {"seed", set(s.seed)},
   };
-  const KeyTable orb_keys{
-      {"features", set(s.orb.features)},
-      {"scale_factor", set(s.orb.scale_factor)},
-      {"levels", set(s.orb.levels)},
-      {"fast_threshold", set(s.orb.fast_threshold)},
-      {"min_fast_threshold", set(s.orb.min_fast_threshold)},
-      {"cell_size", set(s.orb.cell_size)},
-      {"subpixel", set(s.orb.subpixel)},
-  };
-  apply(file, slam, keys, "", "orb");
-  if (slam["orb"]) apply(file, slam["orb"], orb_keys, "orb.");
 }
 
-void applyDistributionSettings(const std::filesystem::path& file, distribution::DistributionSettings& s) {
-  const YAML::Node section = load(file)["distribution"];
-  if (!section) return;
-  const KeyTable keys{
+KeyTable orbKeys(features::OrbOptions& o) {
+  return {
+      {"features", set(o.features)},
+      {"scale_factor", set(o.scale_factor)},
+      {"levels", set(o.levels)},
+      {"fast_threshold", set(o.fast_threshold)},
+      {"min_fast_threshold", set(o.min_fast_threshold)},
+      {"cell_size", set(o.cell_size)},
+      {"subpixel", set(o.subpixel)},
+  };
+}
+
+KeyTable distributionKeys(distribution::DistributionSettings& s) {
+  return {
       {"local_first_batch", set(s.local_first_batch)},
       {"local_max_batch", set(s.local_max_batch)},
       {"local_batch_gap_ms", set(s.local_batch_gap_ms)},
@@ -125,7 +120,44 @@ void applyDistributionSettings(const std::filesystem::path& file, distribution::
       {"release_slow_acks", set(s.release_slow_acks)},
       {"dead_peer_ms", set(s.dead_peer_ms)},
   };
-  apply(file, section, keys, "distribution.");
+}
+
+KeyTable ddsKeys(communication::DdsOptions& o) {
+  return {
+      {"max_datagram_bytes", set(o.max_datagram_bytes)},
+      {"heartbeat_ms", set(o.heartbeat_ms)},
+      {"history_depth", set(o.history_depth)},
+      {"leave_flush_ms", set(o.leave_flush_ms)},
+  };
+}
+
+}  // namespace
+
+std::vector<std::string> settingKeys() {
+  core::SlamSettings slam;
+  distribution::DistributionSettings distribution;
+  communication::DdsOptions dds;
+  std::vector<std::string> keys;
+  for (const auto& key : cameraSettingKeys()) keys.push_back("camera." + key);
+  for (const auto& [key, set] : slamKeys(slam)) keys.push_back("slam." + key);
+  for (const auto& [key, set] : orbKeys(slam.orb)) keys.push_back("slam.orb." + key);
+  for (const auto& [key, set] : distributionKeys(distribution)) keys.push_back("distribution." + key);
+  for (const auto& [key, set] : ddsKeys(dds)) keys.push_back("dds." + key);
+  return keys;
+}
+
+void applySlamSettings(const std::filesystem::path& file, core::SlamSettings& s) {
+  const YAML::Node root = load(file);
+  const YAML::Node slam = root["slam"];
+  if (!slam) return;
+  apply(file, slam, slamKeys(s), "", "orb");
+  if (slam["orb"]) apply(file, slam["orb"], orbKeys(s.orb), "orb.");
+}
+
+void applyDistributionSettings(const std::filesystem::path& file, distribution::DistributionSettings& s) {
+  const YAML::Node section = load(file)["distribution"];
+  if (!section) return;
+  apply(file, section, distributionKeys(s), "distribution.");
   if (s.local_first_batch < 1 || s.local_max_batch < s.local_first_batch || s.global_batch < 1 ||
       s.local_batch_gap_ms < 0 || s.global_batch_gap_ms < 0 || s.lc_global_batch_gap_ms < 0 || s.local_window < 1 ||
       s.min_point_move < 0 || s.point_descriptor_bits < 0 || s.point_normal_deg < 0 || s.point_range_ratio < 0 ||
@@ -138,13 +170,7 @@ void applyDistributionSettings(const std::filesystem::path& file, distribution::
 void applyDdsSettings(const std::filesystem::path& file, communication::DdsOptions& o) {
   const YAML::Node section = load(file)["dds"];
   if (!section) return;
-  const KeyTable keys{
-      {"max_datagram_bytes", set(o.max_datagram_bytes)},
-      {"heartbeat_ms", set(o.heartbeat_ms)},
-      {"history_depth", set(o.history_depth)},
-      {"leave_flush_ms", set(o.leave_flush_ms)},
-  };
-  apply(file, section, keys, "dds.");
+  apply(file, section, ddsKeys(o), "dds.");
   // 576 bytes: the datagram every IPv4 host must take whole; 65500: UDP's limit.
   if (o.max_datagram_bytes < 576 || o.max_datagram_bytes > 65500 || o.heartbeat_ms < 1 || o.heartbeat_ms > 60000 ||
       o.history_depth < 1 || o.leave_flush_ms < 0)

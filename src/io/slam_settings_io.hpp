@@ -1,11 +1,17 @@
 #pragma once
 #include <filesystem>
+#include <string>
+#include <vector>
 
 #include "communication/dds/dds_options.hpp"
 #include "core/system/slam_settings.hpp"
 #include "distribution/distribution_settings.hpp"
 
 namespace hiveslam::io {
+
+// Every key a settings file may hold, by section: "camera.model", "slam.orb.features",
+// "distribution.global_batch", "dds.heartbeat_ms", ... (docs/SETTINGS.md lists each).
+std::vector<std::string> settingKeys();
 
 // Applies the `slam:` section of a settings YAML over `settings` (keys as in SlamSettings, ORB
 // options under `slam: orb:`). Unknown keys are an error naming the file: a typo must not

@@ -17,7 +17,7 @@ namespace hiveslam::communication {
 namespace {
 
 // A peer event handled while the node stops re-plans its tasks and subscribes: that reader once
-// went into a subscriber being deleted (a TR that never finished, session 36). Before start()
+// went into a subscriber being deleted (a TR that never finished). Before start()
 // there is no subscriber at all (it crashed).
 TEST(DdsTransport, SubscribingBeforeStartOrWhileStoppingIsIgnored) {
   DdsTransport transport({232});  // node tests use 1-229, reader_gate_test 230-231 (232 is the last)

@@ -146,8 +146,7 @@ TEST(BundleAdjustment, TheNoiseReadOffTheMedianResidualIgnoresTheTail) {
 // the residuals judged against the map's own noise. At one pixel per level the tail is inside
 // the Huber kernel's quadratic zone and none of it is an outlier; judged by the noise the
 // median reads, most of the tail sits the BA out and almost nothing else does. (Whether that
-// makes maps more accurate is measured on whole rendered sequences, docs/BENCHMARKS.md
-// session 28: a toy problem's pose errors are its noise's.)
+// makes maps more accurate is measured on whole rendered sequences: a toy problem's pose errors are its noise's.)
 TEST(BundleAdjustment, JudgedByItsOwnNoiseTheTailSitsOut) {
   for (unsigned seed : {1u, 2u, 3u}) {
     TailedProblem t(seed);

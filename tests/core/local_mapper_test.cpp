@@ -2,7 +2,7 @@
 // gets it first in the hand-over snapshot, and a tracking node that takes mapping back holds
 // the keyframes it sent. Culled as a neighbour meanwhile, it must stay out when its turn comes:
 // put back, it lived on in that node's map alone, erased at every other node and in the node's
-// own S_full (an ASan run ended with TR a keyframe short of the mapping node, session 24).
+// own S_full (an ASan run ended with TR a keyframe short of the mapping node).
 #include <gtest/gtest.h>
 
 #include "core/mapping/keyframe_insertion.hpp"

@@ -160,7 +160,7 @@ TEST(PatchAlignment, AlignedViewsMeetTheirTrueProjectionsWhereCornersMoveWithThe
     RecordProperty("detected_rms_gap" + std::to_string(gap), std::to_string(c.detected));
     RecordProperty("aligned_rms_gap" + std::to_string(gap), std::to_string(c.aligned));
     ASSERT_GT(c.pairs, 300u) << gap;
-    // Measured (session 47): corners 0.156 and 0.214 px per coordinate at gaps of 5 and 30
+    // Measured: corners 0.156 and 0.214 px per coordinate at gaps of 5 and 30
     // frames, aligned patches 0.058 and 0.060.
     EXPECT_GT(c.detected, 0.12) << gap;  // what the corners show, for the comparison to mean anything
     EXPECT_LT(c.aligned, 0.08) << gap;

@@ -47,7 +47,7 @@ TEST(RealData, Kitti06ForwardDriveIsOneMap) {
 
 // Threaded, as `hiveslam run` goes by default: mapping runs beside tracking, so each run differs.
 // At 1000 features, tracking hovered near its minimum of 30 points and 3 of 18 runs lost the
-// map mid-drive; at 2000, none of 32 (docs/BENCHMARKS.md, session 35).
+// map mid-drive; at 2000, none of 32.
 TEST(RealData, Kitti06ThreadedRunsAreOneMap) {
   if (!fs::exists(fs::path(HIVESLAM_REAL_DATA) / "kitti06_f000-050")) GTEST_SKIP() << "real data not present at " << HIVESLAM_REAL_DATA;
   for (int run = 0; run < 3; ++run) {

@@ -112,7 +112,7 @@ TEST(RemeasureObservations, BringsTheLaterViewsOntoTheTrueProjections) {
   const double before = rms(found), after = rms(mp.problem);
   RecordProperty("corners_rms", std::to_string(before));
   RecordProperty("remeasured_rms", std::to_string(after));
-  // Measured (session 47): 0.20 -> 0.06 px. Each point is where its anchor's corner truly is, so the later views, aligned to the anchor's
+  // Measured: 0.20 -> 0.06 px. Each point is where its anchor's corner truly is, so the later views, aligned to the anchor's
   // patch, land on its projections.
   EXPECT_LT(after, 0.1) << before << " -> " << after;
   EXPECT_LT(after, 0.5 * before) << before << " -> " << after;

@@ -265,8 +265,8 @@ TEST(SlamSystem, TheEndOfARunBringsOneFinalGlobalBa) {
 
 // The map's first keyframe is made of a frame seen before initialization succeeded, and anchors
 // every point of the initial map: its image must be kept like every other keyframe's, or none of
-// those points' observations is measured again (until session 54, 7% of sweep's, all near the
-// start of the run, were kept as found for it).
+// those points' observations is measured again (when it was not kept, 7% of sweep's observations, all near
+// the start of the run, stayed as found).
 TEST(SlamSystem, TheFirstKeyframesPointsAreMeasuredAgainToo) {
   const Sweep sweep;
   SlamSystem slam(SlamSettings{}, sweep.camera, SlamSystem::Mode::Sequential, shippedVocabulary());
@@ -498,7 +498,7 @@ std::pair<size_t, size_t> newPointsOffTheScene(const SlamSettings& settings) {
 
 TEST(SlamSystem, NewPointsLieOnTheSceneThroughAFastTurn) {
   // Measured: 4.4-4.5% off with either search; about two thirds of those at under half their
-  // true distance (docs/BENCHMARKS.md, session 13).
+  // true distance.
   for (const bool by_vocabulary : {false, true}) {
     SlamSettings settings;
     settings.triangulation_by_vocabulary = by_vocabulary;

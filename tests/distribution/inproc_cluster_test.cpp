@@ -213,7 +213,7 @@ TEST(InProcCluster, AMappingNodeThatJoinsMidRunTakesTheWholeMapOver) {
 // The packet that brings LC the map (its first keyframe, with the map's first as companion) is
 // lost, as one written before LC's reader matched is over DDS. LC's next keyframes name a map
 // it never got: it asks the gateway, which answers with a snapshot, and LC closes the loop in
-// that map and ends the run holding what the others hold (CI, session 36: a loop-closing node
+// that map and ends the run holding what the others hold (CI: a loop-closing node
 // that waited for a snapshot nobody sent ended with two keyframes known only by their records).
 TEST(InProcCluster, ALoopClosingNodeThatMissedAMapsStartAsksForTheMap) {
   const ClusterRun run = runThreeNodes("loop", 500, {}, 1);

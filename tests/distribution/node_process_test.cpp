@@ -239,7 +239,7 @@ std::string nodeDigest(const fs::path& node) {
 // Runs the bash command line `run` (no single quotes in it) and returns std::system's status.
 // Past `seconds` it is killed (exit status 124), once every hiveslam process under it has left
 // each thread's stack in out/stacks.log, which nodeEvents shows: a node that hangs once in a
-// hundred runs (TR after releasing its peers, once in session 43) says where.
+// hundred runs (TR after releasing its peers, once) says where.
 int runWithin(int seconds, const fs::path& out, const std::string& run) {
   const std::string script = std::string(HIVESLAM_SOURCE_DIR) + "/tests/run_with_stacks.sh";
   return std::system(("bash " + script + " " + std::to_string(seconds) + " " + out.string() + " '" + run + "'").c_str());
@@ -363,7 +363,7 @@ TEST(NodeProcesses, ATrackingNodeNeedsOneInputAndACalibration) {
 // policy with LC present and no LM) and finishes the sequence with its own map copy. The LM
 // dies once TR has read 30% of the frames (its progress line), not after a fixed time: on a
 // loaded machine a fixed 6 s could leave too little of the 12 s sequence to map after the
-// take-over (CI, session 18: no keyframe mapped by TR).
+// take-over (CI: no keyframe mapped by TR).
 TEST(NodeProcesses, TrackingTakesMappingBackWhenTheMappingNodeDies) {
   testing::TempDir out;
   const std::string bin = HIVESLAM_BINARY, domain = " --domain " + std::to_string(150 + getpid() % 50);
@@ -381,7 +381,7 @@ TEST(NodeProcesses, TrackingTakesMappingBackWhenTheMappingNodeDies) {
   EXPECT_NE(std::find(hosted.begin(), hosted.end(), "lm"), hosted.end()) << tr.dump();
   // The take-over costs frames today: TR's map gets no new points from the death until the
   // lease ends, tracking is lost for about a second and the slow relocalization attempts make
-  // a real-time TR drop frames (docs/BENCHMARKS.md, session 30). How many it keeps depends on
+  // a real-time TR drop frames. How many it keeps depends on
   // the machine's load (149 to 167 of 240 seen with a second test running), so the test asks
   // what does not: that TR tracks again after the take-over and to the end.
   EXPECT_TRUE(tracksTheLastQuarter(out / "tr" / "frames.csv"));
@@ -606,7 +606,7 @@ TEST(NodeProcesses, ThreeNodesOverALossyLink) {
 // average, in bursts of 50 KB keyframes, so it tracks worse than on a fast link; but the
 // end-of-run exchange completes and every node ends with the same map. A leaving node waited
 // 1 s for its last packets to be acknowledged: the gateway's last snapshot was still on the
-// link when it left, and TR waited out 120 s for a Done that never came (session 39).
+// link when it left, and TR waited out 120 s for a Done that never came.
 TEST(NodeProcesses, ThreeNodesOverASlowLink) {
   if (geteuid() != 0) GTEST_SKIP() << "network namespaces need root";
   const Namespaces ns(0, 5000);

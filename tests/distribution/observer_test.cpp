@@ -46,7 +46,7 @@ TEST(ObserverGlobals, ANewerUpdateFromTheSameSenderDropsAnUnfinishedOlderOne) {
 // sends a periodic global map; the newcomer's snapshot follows with the same epoch label and
 // the same number of batches. Collected by label, the first map's last batch completed the
 // snapshot in its place: the returning node never made the snapshot's last keyframes and ended
-// the run without them (session 27, 3 of 11 runs).
+// the run without them (3 of 11 runs).
 TEST(ObserverGlobals, TwoUpdatesWithOneLabelAreCollectedApart) {
   Observer o;
   constexpr uint16_t kLm = 2;

@@ -102,7 +102,7 @@ TEST(ReaderGate, APeerThatLeftOrNeverMatchesIsNotWaitedForLong) {
 // Over Fast DDS: a node that publishes a keyframe the moment it hears of a loop-closing peer
 // (as a mapping node does when it forwards a new map) reaches it. DDS announces a peer a little
 // before that peer's readers match, and what is written in between goes to no one: a returning
-// mapping node forwarded TR's new map to LC that way and LC never got the map (CI, session 36).
+// mapping node forwarded TR's new map to LC that way and LC never got the map (CI).
 // Without the gate, and with writers made at their first write, 1 round in 3 lost its packet.
 TEST(ReaderGate, OverDdsAKeyframeWrittenAsAPeerJoinsReachesIt) {
   const int domain = 230 + getpid() % 2;  // node tests use 1-229, dds_transport_test 232

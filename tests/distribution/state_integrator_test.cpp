@@ -530,7 +530,7 @@ TEST_F(EpochLabels, AnAuthoritativeSnapshotErasesTheSameObjectsFromTheMapAndFrom
 // The same snapshot without the last point, but with nothing newer of the point's node: the
 // sender may not have heard of the point yet, and it stays. Once that node has left, nothing of
 // it is on the way any more, and the point goes. (A mapping node that died left a point at LC
-// that TR, the gateway after it, never got: LC ended one point more than TR, session 40.)
+// that TR, the gateway after it, never got: LC ended one point more than TR.)
 TEST_F(EpochLabels, AnAuthoritativeSnapshotErasesThePointsOfANodeThatLeftThatItsSenderNeverGot) {
   constexpr Id kOrphan = 100 + kPoints - 1;
   MapRecord g;
@@ -555,7 +555,7 @@ TEST_F(EpochLabels, AnAuthoritativeSnapshotErasesThePointsOfANodeThatLeftThatIts
 // keyframe's (tracking numbers a new map's two keyframes, then its points). Judged by the
 // newest id of any kind, the receiver erased the keyframe it had made itself, from its map
 // and from S_full; once the sender mapped it, S_full had it again and the map never did
-// (CI-like run over a lossy link, session 38: TR one keyframe short of LM and LC). A keyframe
+// (CI-like run over a lossy link: TR one keyframe short of LM and LC). A keyframe
 // is known to the sender only if the snapshot holds a newer keyframe of its node.
 TEST_F(EpochLabels, AnAuthoritativeSnapshotTakenBeforeTheSenderMappedAKeyframeLeavesThatKeyframe) {
   MapRecord g;
@@ -575,7 +575,7 @@ TEST_F(EpochLabels, AnAuthoritativeSnapshotTakenBeforeTheSenderMappedAKeyframeLe
 // LC merged or corrected the map and has not published the update yet; the relay of its
 // previous update comes in, labelled with the epoch LC last published. That relay is older
 // than LC's map: taken as authoritative, it erased what the correction brought in (a merged
-// map's keyframes, at LC and then at every node; CI, session 23). It is taken as a stale
+// map's keyframes, at LC and then at every node; CI). It is taken as a stale
 // local map instead, and the caller told so.
 TEST_F(EpochLabels, AnAuthoritativeSnapshotOlderThanACorrectionMadeHereErasesNothing) {
   constexpr Id kUnknownToSender = 100 + kPoints - 1, kNewer = 200;

@@ -3,12 +3,12 @@
 // Mutual discovery: a tracking node counts a peer as there for it only once the peer has heard
 // it too (PeerInfo::seen) and, for a mapping peer, reads its keyframes. Discovery is one-sided:
 // over a lossy link a mapping node heard TR 2.9 s after TR had heard it, and the keyframes TR
-// sent meanwhile reached nobody (TR's first map lost in 3 of 24 runs, session 39).
+// sent meanwhile reached nobody (TR's first map lost in 3 of 24 runs).
 //
 // End of run: the Done comes from the gateway; a gateway that leaves first sends none, and TR
-// must not wait out its whole timeout for it (over a slow link it waited 120 s, session 39).
+// must not wait out its whole timeout for it (over a slow link it waited 120 s).
 // With an LC left, TR finishes the exchange with it as the new gateway; an LC that has answered
-// and is left alone ends too (it waited for the Done until killed, session 40).
+// and is left alone ends too (it waited for the Done until killed).
 #include <gtest/gtest.h>
 
 #include <algorithm>

@@ -240,4 +240,13 @@ TEST(BadInput, ACameraFileIsRecognisedByItsContent) {
 }
 
 }  // namespace
+
+TEST(BadInput, AnUnknownCameraKeyIsNamed) {
+  testing::TempDir dir;
+  const fs::path file = dir / "settings.yaml";
+  std::ofstream(file) << "camera:\n  model: pinhole-radtan\n  width: 640\n  height: 480\n"
+                         "  intrinsics: [500, 500, 320, 240]\n  focal: 500\n";
+  EXPECT_NE(errorOf([&] { loadSettingsCamera(file); }).find("unknown setting 'camera.focal'"), std::string::npos);
+}
+
 }  // namespace hiveslam::io

@@ -274,8 +274,7 @@ void DdsTransport::start(const PeerInfo& self, PeerHandler on_peer) {
   discovery.initial_announcements.period = Duration_t(0, 100'000'000);
   // UDP only, no shared memory. A node killed and started again on the same host can take its
   // old participant's shared-memory port; Fast DDS 2.9 then removes the dead port's segment
-  // while the peers still write into it, and neither side ever matches the other (session 27:
-  // a returning LC saw no peer for 24 s, 1 restart in about 30; upstream eProsima/Fast-DDS
+  // while the peers still write into it, and neither side ever matches the other (a returning LC saw no peer for 24 s, 1 restart in about 30; upstream eProsima/Fast-DDS
   // PR 4728, after 2.9). Nodes on separate devices talk UDP anyway, and a node sends a few
   // Mbps at most.
   pq.transport().use_builtin_transports = false;
@@ -311,7 +310,7 @@ void DdsTransport::start(const PeerInfo& self, PeerHandler on_peer) {
     // Every topic's writer now, before any peer is heard of: its readers match during
     // discovery. Made at its first write instead, a writer sent that packet to no one (a
     // mapping node that returned mid-run forwarded TR's new map to LC that way, and LC never
-    // got the map; CI, session 36).
+    // got the map; CI).
     for (int i = 0; i < kTopicCount; ++i) d.writerFor(static_cast<Topic>(i));
   }
   d.self_node = self.node;
@@ -383,7 +382,7 @@ void DdsTransport::subscribe(Topic topic, Handler handler) {
   if (d.stopping) return;
   std::lock_guard lock(d.entities);
   // Stopping (or not started): a peer event handled during stop() subscribes as the node takes
-  // a task back, and a reader made then went into a subscriber being deleted (session 36: a TR
+  // a task back, and a reader made then went into a subscriber being deleted (a TR
   // once never finished when the returning LM left at the very end of the run).
   if (d.closed) return;
   auto& r = d.readers[static_cast<size_t>(topic)];

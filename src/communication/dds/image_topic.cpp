@@ -54,7 +54,7 @@ struct ImageParticipant {
     // Default transports, shared memory included, unlike the nodes' UDP-only participants
     // (dds_transport.cpp): a 360 KB image is six 64 KB datagrams, more than the kernel's
     // default socket buffer (208 KB), and UDP alone delivered 10 of sweep's 800 frames to a
-    // 1-node TR and 166 to a 3-node one (session 29). The price is the shared-memory port
+    // 1-node TR and 166 to a 3-node one. The price is the shared-memory port
     // hazard on restart described there, for a TR restarted while the camera keeps publishing.
     dds::DomainParticipantQos pq = dds::PARTICIPANT_QOS_DEFAULT;
     pq.wire_protocol().builtin.discovery_config.initial_announcements.count = 5;

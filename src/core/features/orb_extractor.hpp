@@ -19,7 +19,7 @@ struct OrbOptions {
   // Place each corner between pixels (the Harris peak, core/features/corner_refinement): on
   // rendered views a measurement 3x more precise than the FAST pixel, for about 0.7 ms a frame;
   // the synthetic suite's median ATE 9-41% lower. On the real KITTI 07 excerpt, 0 tracking
-  // losses in 56 runs either way and a 3% higher median ATE (docs/BENCHMARKS.md, session 20).
+  // losses in 56 runs either way and a 3% higher median ATE.
   bool subpixel = true;
 };
 

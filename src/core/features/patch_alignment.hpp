@@ -9,8 +9,7 @@
 // the view, so it bends a map through a turn instead of averaging out. Aligning every view to one
 // reference patch measures the same texture location in each: on rendered views of sweep's turn,
 // 0.06 px per coordinate from the true projection against 0.16-0.21 px for the same corner found
-// again at the same level, 5-30 frames apart (tests/core/patch_alignment_test.cpp;
-// docs/BENCHMARKS.md, session 47).
+// again at the same level, 5-30 frames apart (tests/core/patch_alignment_test.cpp).
 #include <Eigen/Core>
 #include <functional>
 #include <opencv2/core.hpp>

@@ -76,8 +76,7 @@ class LoopCloser {
   // `remeasured`: observations measured again (the end of a run): they replace the detected ones,
   // and a loose solve (a pixel per level, nothing left out) goes first. Judged at once against
   // the map's tight noise, the observations that would pull the map into its new shape look
-  // like outliers and sit out: the map stayed at its old scale step (docs/BENCHMARKS.md,
-  // session 47).
+  // like outliers and sit out: the map stayed at its old scale step.
   // Returns false when the map moved while it ran (a node applied a global map meanwhile):
   // nothing was applied, and the caller may solve again.
   bool globalBundleAdjustment(Map& map, int iterations = 0, bool corrected = false,

@@ -4,12 +4,12 @@
 // to warp its reference patch into another view; the fronto-parallel guess is off by 30-70
 // degrees on a wall passed at a grazing angle, and that error follows the view: it bent sweep's
 // maps through the turn as much as re-detected corners do. Normals off by 5 degrees at random
-// cost little (docs/BENCHMARKS.md, session 47).
+// cost little.
 //
 // The plane is found by consensus, not fitted to the whole neighbourhood: a point near the edge
 // of a wall and the floor, or of a box, has neighbours on both faces, and a least-squares plane
 // through all of them is neither face (a fifth of sweep's points got none, or one tilted by
-// tens of degrees; session 52).
+// tens of degrees).
 #include <Eigen/Core>
 #include <optional>
 #include <vector>

@@ -4,7 +4,7 @@
 // On sweep, a whole-map BA of 12 maps with the keyframes of 0.9 s of the U-turn left out (a gap of
 // 25-50 degrees) raises the median keyframe ATE from 1.26 mm to 1.8-2.3 mm; the same cut on a
 // straight stretch adds about 0.1 mm. A tail run's map had such a gap (22 degrees) where culling
-// had taken two keyframes in a row (docs/BENCHMARKS.md, session 59). With a limit set, a
+// had taken two keyframes in a row. With a limit set, a
 // redundant keyframe stays where its neighbours in time would be too far apart without it.
 #include "core/map/keyframe.hpp"
 

@@ -48,7 +48,7 @@ enum class Outliers {
   SecondRound,  // optimize again without the observations the first round rejects
   // Judged on the starting residuals and left out of the one round. For a start that is near
   // its optimum already (a map no correction has moved), where the start tells the outliers as
-  // well as a first round would, at a third of the time (docs/BENCHMARKS.md, session 32).
+  // well as a first round would, at a third of the time.
   FromStart,
 };
 
@@ -61,7 +61,7 @@ struct BaOptions {
   // sparsely (SuiteSparse); dense also keeps CHOLMOD out of the small local windows. In the global
   // BAs of rendered maps (91 and 140 keyframes) dense solves the linear systems 25-40% faster
   // and the whole BA 17-26%; on core_bench's BundleAdjust (a corridor, sparser) dense is 8%
-  // faster at 150 poses and sparse 10% faster at 200 (docs/BENCHMARKS.md, session 32).
+  // faster at 150 poses and sparse 10% faster at 200.
   int dense_schur_max_poses = 150;
 };
 
@@ -92,7 +92,7 @@ double setNoiseFromResiduals(BaProblem& problem, double factor);
 // A global BA's solve. With `loose_first`, one solve at a pixel per level with nothing left out
 // goes first: observations measured again start far from the map's solution, and judged at once
 // against the tight noise, those that would pull the map into its new shape look like outliers
-// and sit out (docs/BENCHMARKS.md, session 47). Then, with noise_factor > 0, the noise is set
+// and sit out. Then, with noise_factor > 0, the noise is set
 // from the residuals (setNoiseFromResiduals) and `outliers` applies; without it, one solve with
 // every observation kept. Returns the sigma set (0 when none).
 double solveGlobal(BaProblem& problem, int iterations, double noise_factor, Outliers outliers, bool loose_first);

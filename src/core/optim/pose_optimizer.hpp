@@ -21,7 +21,7 @@ struct PoseLoss {
   // predicted pose. Cauchy with a 1-sigma scale: a residual of e sigmas weighs 1/(1+e^2), so
   // observations a few sigmas out (a near point slightly misplaced) pull much less on a frame
   // whose other points lie mostly on one wall; SlamSystem::refineFrames. Replayed on three
-  // blackout 3-node runs' refinements (session 51), the worst frame went from 18.5/11.0/23.1 mm
+  // blackout 3-node runs' refinements, the worst frame went from 18.5/11.0/23.1 mm
   // to 9.3/9.7/7.2 mm and the frames' RMS from 2.60/2.59/2.46 to 2.38/2.51/2.31 mm.
   enum class Kind { Huber, Cauchy } kind = Kind::Huber;
   double scale = 2.4477;  // sqrt(5.991)

@@ -7,8 +7,7 @@
 //
 // Why: on sweep, a whole-map BA of the re-measured observations bends the map through the turn
 // about half as much (scale step sd 0.21% -> 0.10%; keyframe ATE median 3.6 -> 1.5 mm over 12 maps),
-// where a BA of the detected corners returns to the step from the true poses: the corners hold it
-// (docs/BENCHMARKS.md, session 47). The plane comes from the point's neighbours
+// where a BA of the detected corners returns to the step from the true poses: the corners hold it. The plane comes from the point's neighbours
 // (map/point_normals.hpp); the fronto-parallel guess gains nothing.
 #include <functional>
 #include <memory>

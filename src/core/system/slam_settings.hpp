@@ -36,8 +36,7 @@ struct SlamSettings {
   // culling limit below at 5 degrees, 3-node real-time sweep runs keep about 12 more keyframes
   // (102 against 90) and lost their tail in 8 interleaved pairs, and bench64 held every rule; at
   // 10 degrees they kept it. Off for now: the standalone system's CPU on figure8 rose 65%, and
-  // SlamSystem.ClosesTheLoopOfARenderedLoop no longer saw loop closing halve the revisit gap
-  // (docs/BENCHMARKS.md, session 59). Set 5 to use it.
+  // SlamSystem.ClosesTheLoopOfARenderedLoop no longer saw loop closing halve the revisit gap. Set 5 to use it.
   double keyframe_turn_deg = 0.0;
   int keyframe_min_inliers = 15;
   // Loss handling: a new map after this many lost frames once the map is past its first
@@ -46,16 +45,14 @@ struct SlamSettings {
   // Local mapping
   // Neighbours searched for new points (and, below, for duplicates). ORB-SLAM's monocular value
   // is 20; 20 here helped the sequential runs (median ATE at six feature budgets: figure8 10.6 ->
-  // 9.4 mm, sweep 10.0 -> 6.2) but not the real-time bench (3-node sweep median 6.1 -> 12.7 mm):
-  // docs/BENCHMARKS.md, session 10.
+  // 9.4 mm, sweep 10.0 -> 6.2) but not the real-time bench (3-node sweep median 6.1 -> 12.7 mm).
   int triangulation_neighbours = 10;
   double triangulation_max_cos_parallax = 0.9998;  // new points need a wider angle (1.15 deg)
   // Candidates for new points only under the same vocabulary node (ORB-SLAM's way) instead of
   // along the whole epipolar band. Sequential runs at twelve feature budgets: sweep median 8.9
   // -> 5.2 mm, blackout 9.4 -> 6.0, CPU -25%; but about 12% fewer points, and in the real-time
   // bench the 3-node outlier rule failed on three sequences (one TR lost figure8's fast turn,
-  // short of points) where it had held on all four: off until two benches say otherwise
-  // (docs/BENCHMARKS.md, session 13).
+  // short of points) where it had held on all four: off until two benches say otherwise.
   bool triangulation_by_vocabulary = false;
   int fusion_neighbours = 10;
   int local_ba_iterations = 10;
@@ -63,7 +60,7 @@ struct SlamSettings {
   // scale (ORB-SLAM's 0.9). 0.95 keeps a third more keyframes and cut the standalone system's
   // median ATE (sequential, perturbed: figure8 10.6 -> 7.6 mm, sweep 10.0 -> 5.1; realtime
   // bench: all four sequences), but the 3-node system got worse with it (sweep median 5.2 mm
-  // over 7 runs at 0.9, about 10 over 8 at 0.95): docs/BENCHMARKS.md, session 8.
+  // over 7 runs at 0.9, about 10 over 8 at 0.95).
   double redundant_keyframe_ratio = 0.9;
   // A redundant keyframe stays when its neighbours in time would be more than this many degrees
   // apart in viewing direction without it (0: no limit; core/mapping/keyframe_gap.hpp, and
@@ -87,7 +84,7 @@ struct SlamSettings {
   // about a tenth of the observations sit 0.6-2.4 px off under the true geometry too (corners
   // whose refined position moves with the view): inside a one-pixel Huber kernel they were
   // weighed in full. Six sequential sweep maps, the final BA again: keyframe ATE 9.1 5.8 3.4
-  // 4.6 2.4 8.5 -> 3.9 4.1 2.3 1.2 2.2 3.5 mm (docs/BENCHMARKS.md, session 28).
+  // 4.6 2.4 8.5 -> 3.9 4.1 2.3 1.2 2.2 3.5 mm.
   double global_ba_noise_factor = 1.5;
   // With the noise factor: a global BA of a map no loop or merge has just moved judges its
   // outliers on the residuals it starts from and solves once without them, instead of solving
@@ -96,26 +93,25 @@ struct SlamSettings {
   // bigloop; CPU -5 to -17%) and about the same ATE on figure8 and bigloop, but the medians
   // of sweep 3.7 -> 4.5 mm and blackout 3.0 -> 3.4. The start leaves out 5-10% more
   // observations than a first round does, as many among the newest keyframes; why that costs
-  // sweep is not traced. Off until a bench says otherwise (docs/BENCHMARKS.md, session 32).
+  // sweep is not traced. Off until a bench says otherwise.
   bool global_ba_outliers_from_start = false;
   // A global BA each time a map has grown by this many keyframes, loop or not (0: only after
   // loops and merges). Local BA holds its border where earlier windows left it; this lets
   // every observation weigh in again. Sequential runs at six feature budgets: figure8 median
-  // 9.9 -> 5.7 mm, worst 24.0 -> 6.3; sweep 10.0 -> 7.5 (docs/BENCHMARKS.md, session 12).
+  // 9.9 -> 5.7 mm, worst 24.0 -> 6.3; sweep 10.0 -> 7.5.
   int global_ba_every_keyframes = 10;
   // At the end of a run (SlamSystem::drain), once every keyframe is mapped: one more global BA
   // of each map with this many iterations (0: none), on whichever node hosts loop closing. In
   // real time the map ends where its last local BAs left it, up to 10 keyframes after the last
   // global BA; sequential runs end converged and are unchanged (figure8 at six feature budgets:
-  // 5.2-6.3 -> 5.0-6.1 mm), real-time ones gain (figure8: 9.1 9.8 8.1 -> 5.8 6.9 7.6 mm):
-  // docs/BENCHMARKS.md, session 14.
+  // 5.2-6.3 -> 5.0-6.1 mm), real-time ones gain (figure8: 9.1 9.8 8.1 -> 5.8 6.9 7.6 mm).
   int final_global_ba_iterations = 50;
   // Before that final BA: every observation of the maps measured again by patch alignment
   // against its point's first view (optim/remeasure_observations.hpp), by the node that made the
   // keyframes and holds their images, and the final BA runs loose (a pixel per level, nothing
   // left out) before its usual noise-scaled solve. Re-detected corners move with the view by a
   // few tenths of a pixel and bend sweep's maps through the turn; on saved maps this halved the
-  // scale step's spread (0.21% -> 0.10%) and the keyframe ATE (docs/BENCHMARKS.md, session 47).
+  // scale step's spread (0.21% -> 0.10%) and the keyframe ATE.
   bool remeasure = true;
   // The keyframe images kept for it (level 0, 361 KB each at 752x480); past it, none more.
   int remeasure_image_budget_mb = 512;

@@ -166,7 +166,7 @@ void SlamSystem::finalBundleAdjustment(Map& map) {
   const Remeasurements r = remeasurements();
   // Where loop closing is a node of its own, the gateway's relay of its last global map may
   // land while this BA runs: the map moves, and the result is thrown away (2 of 7 traced
-  // 3-node sweep runs once ended on the corners' scale step for that; session 50). The relay
+  // 3-node sweep runs once ended on the corners' scale step for that). The relay
   // comes once per update, so a second try finds the map still.
   constexpr int kTries = 3;
   for (int attempt = 0; attempt < kTries && !map.merged_into.load(); ++attempt)
