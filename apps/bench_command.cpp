@@ -155,6 +155,7 @@ nlohmann::json BenchRow::toJson() const {
 
 void addBenchCommand(CLI::App& app) {
   auto* cmd = app.add_subcommand("bench", "The paper's protocol: 1-node and 3-node runs, N repeats, a table");
+  cmd->footer("Example:\n  hiveslam bench seq/sweep seq/figure8 --nodes 1,3 --repeats 5 --out out/bench");
   auto o = std::make_shared<BenchOptions>();
   cmd->add_option("SEQUENCES", o->sequences,
                   "Datasets (what `hiveslam run` reads), each as PATH or PATH:SETTINGS.yaml (its own settings)")

@@ -136,6 +136,7 @@ ClusterResult runCluster(const ClusterOptions& o) {
 
 void addClusterCommand(CLI::App& app) {
   auto* cmd = app.add_subcommand("cluster", "Run TR, LM and LC as separate processes on this machine");
+  cmd->footer("Example:\n  hiveslam cluster --nodes 3 seq/figure8 --realtime --out out/cluster");
   auto o = std::make_shared<ClusterOptions>();
   cmd->add_option("--nodes", o->nodes, "1 (standalone), 2 (TR + LM) or 3 (TR + LM + LC)")->capture_default_str();
   cmd->add_option("DATASET", o->dataset, "What `hiveslam run` reads")->required();

@@ -14,6 +14,7 @@ namespace hiveslam::apps {
 
 void addDemoCommand(CLI::App& app) {
   auto* cmd = app.add_subcommand("demo", "Render a sequence, run it on 1 and 3 nodes, print a table (built-in default)");
+  cmd->footer("Example:\n  hiveslam demo --out demo_out");
   auto out = std::make_shared<std::string>("demo_out");
   auto options = std::make_shared<synth::SequenceOptions>();
   auto repeats = std::make_shared<int>(1);

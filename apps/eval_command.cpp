@@ -91,10 +91,12 @@ std::shared_ptr<core::Map> pickMap(const std::vector<std::shared_ptr<core::Map>>
 
 void addEvalCommand(CLI::App& app) {
   auto* eval = app.add_subcommand("eval", "Evaluate a trajectory against ground truth");
+  eval->footer("Example:\n  hiveslam eval ate seq/figure8/mav0/state_groundtruth_estimate0/data.csv out/figure8/trajectory.tum");
   eval->require_subcommand(1);
 
   auto ate = std::make_shared<Common>();
   auto* ate_cmd = eval->add_subcommand("ate", "Absolute trajectory error (evo_ape -as equivalent)");
+  ate_cmd->footer("Example:\n  hiveslam eval ate seq/figure8/mav0/state_groundtruth_estimate0/data.csv out/figure8/trajectory.tum --stretches 10");
   addCommon(ate_cmd, *ate);
   auto stretches = std::make_shared<int>(0);
   ate_cmd->add_option("--stretches", *stretches,
@@ -136,6 +138,7 @@ void addEvalCommand(CLI::App& app) {
   auto rotation = std::make_shared<bool>(false);
   auto all_pairs = std::make_shared<bool>(false);
   auto* rpe_cmd = eval->add_subcommand("rpe", "Relative pose error (evo_rpe equivalent)");
+  rpe_cmd->footer("Example:\n  hiveslam eval rpe GT.tum out/figure8/trajectory.tum --delta 1 --unit m");
   addCommon(rpe_cmd, *rpe);
   rpe_cmd->add_option("--delta", *delta, "Distance between the poses of a pair")->capture_default_str();
   rpe_cmd->add_option("--unit", *unit, "frames | m")->capture_default_str()->check(CLI::IsMember({"frames", "m"}));
@@ -163,6 +166,7 @@ void addEvalCommand(CLI::App& app) {
   auto step = std::make_shared<Common>();
   auto step_split = std::make_shared<eval::StretchSplit>();
   auto* step_cmd = eval->add_subcommand("scale-step", "Scale of a later stretch of the run relative to an earlier one");
+  step_cmd->footer("Example:\n  hiveslam eval scale-step GT.tum out/sweep/trajectory.tum --before 16 --after 24");
   addCommon(step_cmd, *step);
   addSplit(step_cmd, *step_split);
   step_cmd->callback([=]() {
@@ -184,6 +188,7 @@ void addEvalCommand(CLI::App& app) {
   auto map_id = std::make_shared<long>(-1);
   auto* precision_cmd = eval->add_subcommand(
       "scale-precision", "How precisely a saved map's measurements fix the scale step between two stretches");
+  precision_cmd->footer("Example:\n  hiveslam eval scale-precision out/sweep/atlas.bin --before 16 --after 24");
   precision_cmd->add_option("ATLAS", *atlas, "Atlas file (hiveslam run --atlas-out)")->required();
   addSplit(precision_cmd, precision->split);
   precision_cmd->add_option("--map", *map_id, "Map id (default: the one with the most keyframes)");
@@ -211,6 +216,7 @@ void addEvalCommand(CLI::App& app) {
   auto remeasure_map = std::make_shared<long>(-1);
   auto* remeasure_cmd = eval->add_subcommand(
       "remeasure", "A saved map bundle-adjusted on its corners and on patch-aligned observations, against ground truth");
+  remeasure_cmd->footer("Example:\n  hiveslam eval remeasure out/sweep/atlas.bin seq/sweep --before 16 --after 24");
   remeasure_cmd->add_option("ATLAS", *remeasure_atlas, "Atlas file (hiveslam run --atlas-out)")->required();
   remeasure_cmd->add_option("DATASET", *remeasure_dataset, "The dataset the map was made from (its images and ground truth)")
       ->required();
@@ -234,6 +240,7 @@ void addEvalCommand(CLI::App& app) {
 
   auto bench_file = std::make_shared<std::string>();
   auto* bench_cmd = eval->add_subcommand("bench", "A saved bench's table and acceptance rules (DIR/bench.json)");
+  bench_cmd->footer("Example:\n  hiveslam eval bench out/bench/bench.json");
   bench_cmd->add_option("BENCH_JSON", *bench_file, "bench.json written by hiveslam bench")->required();
   bench_cmd->callback([bench_file]() {
     std::ifstream in(*bench_file);

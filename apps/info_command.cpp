@@ -12,6 +12,7 @@ namespace hiveslam::apps {
 
 void addInfoCommand(CLI::App& app) {
   auto* cmd = app.add_subcommand("info", "Describe a dataset (format, camera, frames, ground truth)");
+  cmd->footer("Example:\n  hiveslam info seq/figure8 --check --image-stats --every 10");
   auto path = std::make_shared<std::string>();
   auto settings = std::make_shared<std::string>();
   auto times = std::make_shared<std::string>();

@@ -22,6 +22,9 @@ int main(int argc, char** argv) {
   google::InitGoogleLogging(argv[0]);
   CLI::App app{"hiveslam: self-organizing distributed monocular visual SLAM"};
   app.require_subcommand(1);
+  app.footer("Example:\n  hiveslam demo                 (render a sequence, run it on 1 and 3 nodes)\n"
+             "  hiveslam run DATASET --out DIR\n"
+             "Each command: hiveslam COMMAND --help");
   app.set_version_flag("--version", "hiveslam 0.1.0");
   hiveslam::apps::addSynthCommand(app);
   hiveslam::apps::addEvalCommand(app);

@@ -108,6 +108,7 @@ void serve(const NodeCommandOptions& o, communication::Task task) {
 
 void addNodeCommand(CLI::App& app) {
   auto* cmd = app.add_subcommand("node", "Run one node (tr, lm or lc) of the distributed system over Fast DDS");
+  cmd->footer("Example:\n  hiveslam node --task lm --domain 7 --out lm   (then, on the camera device:)\n  hiveslam node --task tr seq/figure8 --realtime --domain 7 --expect lm --out tr");
   auto o = std::make_shared<NodeCommandOptions>();
   cmd->add_option("--task", o->task, "tr (tracking), lm (local mapping) or lc (loop closing)")->required();
   cmd->add_option("DATASET", o->dataset, "TR's input: what `hiveslam run` reads");

@@ -63,6 +63,7 @@ void play(const PlayOptions& o) {
 
 void addPlayCommand(CLI::App& app) {
   auto* cmd = app.add_subcommand("play", "Publish a dataset as a ROS 2 sensor_msgs/msg/Image topic at its frame rate");
+  cmd->footer("Example:\n  hiveslam play seq/figure8 --topic /camera/image_raw --domain 7");
   auto o = std::make_shared<PlayOptions>();
   cmd->add_option("DATASET", o->dataset, "What `hiveslam run` reads")->required();
   cmd->add_option("--topic", o->topic, "ROS topic")->capture_default_str();

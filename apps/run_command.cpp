@@ -315,6 +315,7 @@ RunSummary runSlam(const RunOptions& o) {
 
 void addRunCommand(CLI::App& app) {
   auto* cmd = app.add_subcommand("run", "Run standalone monocular SLAM on a dataset");
+  cmd->footer("Example:\n  hiveslam run seq/figure8 --realtime --out out/figure8");
   auto o = std::make_shared<RunOptions>();
   cmd->add_option("DATASET", o->dataset, "EuRoC/TUM-VI folder, TUM RGB-D folder, image folder or video");
   cmd->add_option("--topic", o->topic, "Instead of a DATASET: a ROS 2 sensor_msgs/msg/Image topic (e.g. /camera/image_raw)");

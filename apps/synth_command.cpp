@@ -34,6 +34,7 @@ void render(const synth::SequenceOptions& o, const std::filesystem::path& out, c
 
 void addSynthCommand(CLI::App& app) {
   auto* cmd = app.add_subcommand("synth", "Render a synthetic sequence with exact ground truth (EuRoC layout)");
+  cmd->footer("Example:\n  hiveslam synth --trajectory figure8 --seed 1 --frames 1000 --out seq/figure8");
   auto o = std::make_shared<synth::SequenceOptions>();
   auto out = std::make_shared<std::string>();
   auto size = std::make_shared<std::string>("752x480");

@@ -48,8 +48,10 @@ std::vector<std::filesystem::path> collectImages(const std::vector<std::string>&
 
 void addVocabCommand(CLI::App& app) {
   auto* cmd = app.add_subcommand("vocab", "Train or inspect a bag-of-words vocabulary");
+  cmd->footer("Example:\n  hiveslam vocab info data/vocabulary/orb_k10_l4.bin");
   cmd->require_subcommand(1);
   auto* train = cmd->add_subcommand("train", "Train a vocabulary on the ORB features of images");
+  train->footer("Example:\n  hiveslam vocab train /usr/share/doc/opencv-doc/examples/data seq/figure8 --every 3 --out vocab.bin");
   auto inputs = std::make_shared<std::vector<std::string>>();
   auto out = std::make_shared<std::string>();
   auto every = std::make_shared<int>(1);
@@ -88,6 +90,7 @@ void addVocabCommand(CLI::App& app) {
                voc.words(), voc.branching(), voc.depth(), s, *out);
   });
   auto* info = cmd->add_subcommand("info", "Describe a vocabulary file");
+  info->footer("Example:\n  hiveslam vocab info data/vocabulary/orb_k10_l4.bin");
   auto file = std::make_shared<std::string>();
   info->add_option("FILE", *file, "Vocabulary file")->required();
   info->callback([=]() {
