@@ -1,5 +1,6 @@
 #pragma once
 // The paper's benchmark protocol (hiveslam bench), also behind the demo.
+#include <filesystem>
 #include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
@@ -33,6 +34,8 @@ nlohmann::json runBench(const BenchOptions& options);
 // "PATH[:SETTINGS]" split into the dataset and its settings file (empty: none given).
 std::pair<std::string, std::string> splitSequence(const std::string& arg);
 std::string benchTable(const nlohmann::json& rows);
+// The table as a figure (bench.png): ATE, CPU and bandwidth at TR per sequence and node count.
+void plotBench(const std::filesystem::path& png, const nlohmann::json& rows);
 // Which of issue 5's acceptance rules the rows' 1-node and 3-node runs hold; empty without both.
 std::string benchRules(const nlohmann::json& rows);
 

@@ -9,12 +9,14 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <opencv2/core.hpp>
 
 #include "apps/bench.hpp"
 #include "apps/cluster.hpp"
 #include "apps/commands.hpp"
 #include "common/error.hpp"
 #include "eval/bench_rules.hpp"
+#include "eval/chart.hpp"
 #include "eval/error_stats.hpp"
 
 namespace hiveslam::apps {
@@ -92,7 +94,31 @@ nlohmann::json runBench(const BenchOptions& o) {
   }
   std::filesystem::create_directories(out);
   std::ofstream(out / "bench.json") << all.dump(2) << "\n";
+  plotBench(out / "bench.png", all);
   return all;
+}
+
+void plotBench(const std::filesystem::path& png, const nlohmann::json& rows) {
+  // One bar per sequence and node count (colour by node count), the worst run as a whisker.
+  const cv::Scalar colors[] = {{200, 120, 40}, {60, 160, 60}, {40, 90, 200}};
+  std::vector<eval::Bar> ate, cpu, bandwidth;
+  for (const auto& r : rows) {
+    const int nodes = r.at("nodes").get<int>();
+    const std::string label = fmt::format("{} {}n", r.at("sequence").get<std::string>(), nodes);
+    const cv::Scalar color = colors[std::clamp(nodes, 1, 3) - 1];
+    auto bar = [&](const char* key, double scale) {
+      const auto& s = r.at(key);
+      return eval::Bar{label, scale * s.at("median").get<double>(), scale * s.at("max").get<double>(), color};
+    };
+    if (r.value("ground_truth", true)) ate.push_back(bar("ate", 1000));
+    cpu.push_back(bar("cpu_percent", 1));
+    bandwidth.push_back(bar("bw_tr", 1));
+  }
+  std::vector<cv::Mat> charts;
+  if (!ate.empty()) charts.push_back(eval::barChart(ate, {"ATE RMSE per configuration (median; tick: the worst run)", "", "ATE (mm)"}));
+  charts.push_back(eval::barChart(cpu, {"CPU at the tracking node", "", "CPU (% of a core)"}));
+  charts.push_back(eval::barChart(bandwidth, {"Bandwidth at the tracking node", "", "Mbps"}));
+  eval::writeCharts(png, charts);
 }
 
 std::string benchTable(const nlohmann::json& rows) {

@@ -15,5 +15,7 @@ void addNodeCommand(CLI::App& app);
 void addClusterCommand(CLI::App& app);
 void addBenchCommand(CLI::App& app);
 void addPlayCommand(CLI::App& app);
+void addViewCommand(CLI::App& app);
+void addTopicsCommand(CLI::App& app);
 
 }  // namespace hiveslam::apps

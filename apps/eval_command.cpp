@@ -18,6 +18,7 @@
 #include "eval/scale_step.hpp"
 #include "eval/stretch_errors.hpp"
 #include "eval/trajectory_error.hpp"
+#include "eval/error_plots.hpp"
 #include "eval/trajectory_plot.hpp"
 #include "core/features/orb_extractor.hpp"
 #include "core/optim/map_ba_problem.hpp"
@@ -98,16 +99,20 @@ void addEvalCommand(CLI::App& app) {
   auto* ate_cmd = eval->add_subcommand("ate", "Absolute trajectory error (evo_ape -as equivalent)");
   ate_cmd->footer("Example:\n  hiveslam eval ate seq/figure8/mav0/state_groundtruth_estimate0/data.csv out/figure8/trajectory.tum --stretches 10");
   addCommon(ate_cmd, *ate);
+  auto plots = std::make_shared<std::pair<std::string, std::string>>();
+  ate_cmd->add_option("--plot-time", plots->first, "Write a PNG of the position error over time");
+  ate_cmd->add_option("--plot-axes", plots->second, "Write a PNG of the error along x, y and z over time");
   auto stretches = std::make_shared<int>(0);
   ate_cmd->add_option("--stretches", *stretches,
                       "Also cut the run into N equal stretches of time: each one's mean error and own Sim3 scale")
       ->check(CLI::Range(1, 1000));
-  ate_cmd->callback([ate, stretches]() {
+  ate_cmd->callback([ate, stretches, plots]() {
     const Loaded l = load(*ate);
     const auto r = eval::computeAte(l.gt, l.est, l.match);
-    if (!ate->plot.empty())
-      eval::plotTopView(ate->plot, r.pair.ref, r.pair.est,
-                        {fmt::format("ATE RMSE {:.4f} m ({} poses)", r.stats.rmse, r.stats.count), 900, {}});
+    const std::string title = fmt::format("ATE RMSE {:.4f} m ({} poses)", r.stats.rmse, r.stats.count);
+    if (!ate->plot.empty()) eval::plotTopView(ate->plot, r.pair.ref, r.pair.est, {title, 900, {}});
+    if (!plots->first.empty()) eval::plotErrorOverTime(plots->first, r, title);
+    if (!plots->second.empty()) eval::plotAxisErrors(plots->second, r, title);
     if (ate->json) {
       nlohmann::json j = eval::toJson(r.stats);
       j["alignment"] = eval::toString(l.match.alignment);
@@ -242,13 +247,16 @@ void addEvalCommand(CLI::App& app) {
   auto* bench_cmd = eval->add_subcommand("bench", "A saved bench's table and acceptance rules (DIR/bench.json)");
   bench_cmd->footer("Example:\n  hiveslam eval bench out/bench/bench.json");
   bench_cmd->add_option("BENCH_JSON", *bench_file, "bench.json written by hiveslam bench")->required();
-  bench_cmd->callback([bench_file]() {
+  auto bench_plot = std::make_shared<std::string>();
+  bench_cmd->add_option("--plot", *bench_plot, "Write the table as a figure (ATE, CPU and bandwidth at TR) to this PNG");
+  bench_cmd->callback([bench_file, bench_plot]() {
     std::ifstream in(*bench_file);
     if (!in) throw InputError("cannot open " + *bench_file);
     const auto rows = nlohmann::json::parse(in, nullptr, false);
     if (rows.is_discarded() || !rows.is_array()) throw InputError(*bench_file + " is not a bench.json (a JSON array of rows)");
     try {
       fmt::print("{}{}", benchTable(rows), benchRules(rows));
+      if (!bench_plot->empty()) plotBench(*bench_plot, rows);
     } catch (const nlohmann::json::exception& e) {
       throw InputError(*bench_file + ": a row lacks what hiveslam bench writes (" + e.what() + ")");
     }

@@ -36,6 +36,8 @@ int main(int argc, char** argv) {
   hiveslam::apps::addClusterCommand(app);
   hiveslam::apps::addBenchCommand(app);
   hiveslam::apps::addPlayCommand(app);
+  hiveslam::apps::addViewCommand(app);
+  hiveslam::apps::addTopicsCommand(app);
   int status = 0;
   try {
     app.parse(argc, argv);

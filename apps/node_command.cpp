@@ -33,6 +33,8 @@ struct NodeCommandOptions {
   int domain = 0, id = 0;
   bool realtime = false, no_loop_closing = false;
   int wait_seconds = 20;
+  bool no_ros = false;
+  LiveViewOptions live;
 };
 
 uint16_t defaultId(communication::Task t) { return static_cast<uint16_t>(static_cast<int>(t) + 1); }
@@ -56,10 +58,20 @@ void serve(const NodeCommandOptions& o, communication::Task task) {
   std::signal(SIGINT, onSignal);
   std::signal(SIGTERM, onSignal);
   node.start();
+  LiveViewOptions lv = o.live;
+  lv.ros = !o.no_ros;
+  lv.domain = o.domain;
+  lv.node = o.name.empty() ? communication::taskName(task) : o.name;
+  if (!o.config.empty()) io::applyViewSettings(o.config, lv.settings);
+  std::unique_ptr<LiveViewStack> live;
+  if (lv.any())
+    live = std::make_unique<LiveViewStack>(lv, slam, [&node, &monitor] { return node.report(monitor.wallSeconds()); },
+                                           [&slam] { return slam.hosting().mapping; });
   fmt::print(stderr, "node {} ({}) on DDS domain {}: waiting for keyframes\n", id, communication::taskName(task), o.domain);
   bool done = false;
   while (!g_stop && !(done = node.waitUntilDone(std::chrono::milliseconds(200)))) {
   }
+  if (live) live->finish();
   nlohmann::json report = node.report(monitor.wallSeconds());
   report["thread_cpu_seconds"] = eval::ResourceMonitor::threadCpuSeconds();  // before threads end
   node.stop();
@@ -125,6 +137,8 @@ void addNodeCommand(CLI::App& app) {
   cmd->add_option("--times", o->times, "TR: times file for image folders and videos");
   cmd->add_flag("--realtime", o->realtime, "TR: feed frames at their timestamps");
   cmd->add_flag("--no-loop-closing", o->no_loop_closing, "Switch loop closing off");
+  addViewerOptions(cmd, o->live);
+  cmd->add_flag("--no-ros", o->no_ros, "Do not publish the ROS 2 visualization topics (/hiveslam/<name>/...)");
   cmd->add_option("--atlas-out", o->atlas_out, "Save the node's maps to an atlas file after the run (the same on every node after the end-of-run exchange)");
   cmd->callback([o]() {
     communication::Task task;
@@ -154,6 +168,8 @@ void addNodeCommand(CLI::App& app) {
     run.network.id = o->id > 0 ? static_cast<uint16_t>(o->id) : 1;
     run.network.name = o->name.empty() ? "tr" : o->name;
     run.network.wait_seconds = o->wait_seconds;
+    run.live = o->live;
+    run.live.ros = !o->no_ros;
     std::string rest = o->expect;
     while (!rest.empty()) {
       const auto comma = rest.find(',');

@@ -3,6 +3,8 @@
 #include <fmt/ranges.h>
 
 #include <algorithm>
+#include <atomic>
+#include <csignal>
 #include <filesystem>
 #include <chrono>
 #include <fstream>
@@ -17,6 +19,7 @@
 #include "communication/dds/dds_transport.hpp"
 #include "distribution/distributed_node.hpp"
 #include "core/system/slam_system.hpp"
+#include "eval/error_plots.hpp"
 #include "eval/resource_monitor.hpp"
 #include "eval/trajectory_error.hpp"
 #include "eval/trajectory_plot.hpp"
@@ -88,6 +91,18 @@ void writeFrameLog(const std::filesystem::path& path, const std::vector<core::Fr
                      r.keyframe ? 1 : 0, r.tracking_ms, r.map, r.reference ? r.reference->id : core::kNoId,
                      r.reference && r.reference->bad ? 1 : 0);
   if (!f) throw InputError("cannot write " + path.string());
+}
+
+std::atomic<bool> g_interrupted{false};
+extern "C" void onInterrupt(int) { g_interrupted = true; }
+
+void waitForInterrupt(const std::string& message) {
+  fmt::print(stderr, "{}\n", message);
+  auto previous_int = std::signal(SIGINT, onInterrupt);
+  auto previous_term = std::signal(SIGTERM, onInterrupt);
+  while (!g_interrupted) std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  std::signal(SIGINT, previous_int);
+  std::signal(SIGTERM, previous_term);
 }
 
 }  // namespace
@@ -165,6 +180,20 @@ RunSummary runSlam(const RunOptions& o) {
     fmt::print(stderr, "atlas {}: {} maps, {} keyframes{}\n", o.atlas_in, maps.size(), kfs,
                o.localization ? " (localization only)" : "");
   }
+  std::unique_ptr<LiveViewStack> live;
+  if (o.live.any()) {
+    LiveViewOptions lv = o.live;
+    if (!o.config.empty()) io::applyViewSettings(o.config, lv.settings);
+    if (node) {
+      lv.node = o.network.name;
+      lv.domain = o.network.domain;
+    } else {
+      lv.domain = o.topic_domain;
+    }
+    std::function<nlohmann::json()> node_report;
+    if (node) node_report = [&node, &monitor] { return node->report(monitor.wallSeconds()); };
+    live = std::make_unique<LiveViewStack>(lv, slam, node_report, [&slam] { return slam.hosting().mapping; });
+  }
   Progress progress("tracking");
   const int total = static_cast<int>(source->size().value_or(0));
   int n = 0, dropped = 0;
@@ -205,6 +234,7 @@ RunSummary runSlam(const RunOptions& o) {
   } else {
     slam.drain();  // the end of the run: the last keyframes mapped, the final global BA
   }
+  if (live) live->finish();  // the final maps on the page, before the node leaves
   // Before the threads end: a thread that has ended is no longer in /proc.
   const auto thread_cpu = eval::ResourceMonitor::threadCpuSeconds();
   if (node) node->stop();
@@ -292,10 +322,11 @@ RunSummary runSlam(const RunOptions& o) {
       report["ate"] = eval::toJson(ate.stats);
       report["ate"]["path_length"] = ate.reference_length;
       report["ate"]["percent_of_path"] = 100.0 * ate.stats.rmse / std::max(ate.reference_length, 1e-9);
-      eval::plotTopView(out / "trajectory.png", ate.pair.ref, ate.pair.est,
-                        {fmt::format("ATE RMSE {:.4f} m over {:.1f} m ({} poses)", ate.stats.rmse, ate.reference_length,
-                                     ate.stats.count),
-                         900, plot_events});
+      const std::string title =
+          fmt::format("ATE RMSE {:.4f} m over {:.1f} m ({} poses)", ate.stats.rmse, ate.reference_length, ate.stats.count);
+      eval::plotTopView(out / "trajectory.png", ate.pair.ref, ate.pair.est, {title, 900, plot_events});
+      eval::plotErrorOverTime(out / "error_time.png", ate, title);
+      eval::plotAxisErrors(out / "error_axes.png", ate, title);
       ate_line = fmt::format("ATE RMSE {:.4f} m ({:.2f}% of {:.1f} m)", ate.stats.rmse,
                              100.0 * ate.stats.rmse / std::max(ate.reference_length, 1e-9), ate.reference_length);
     } catch (const InputError& e) {
@@ -304,6 +335,7 @@ RunSummary runSlam(const RunOptions& o) {
   }
   if (node) report.update(node_report);
   std::ofstream(out / "report.json") << report.dump(2) << "\n";
+  if (live && o.viewer_wait && live->port() >= 0) waitForInterrupt(fmt::format("run over: the live view stays at port {} until Ctrl-C", live->port()));
   RunSummary summary;
   summary.report = report;
   summary.line = fmt::format("frames {} tracked {} ({:.1f}%) failures {} keyframes {} maps {} | {} | tracking median {:.1f} ms",
@@ -315,7 +347,7 @@ RunSummary runSlam(const RunOptions& o) {
 
 void addRunCommand(CLI::App& app) {
   auto* cmd = app.add_subcommand("run", "Run standalone monocular SLAM on a dataset");
-  cmd->footer("Example:\n  hiveslam run seq/figure8 --realtime --out out/figure8");
+  cmd->footer("Example:\n  hiveslam run seq/figure8 --realtime --out out/figure8 --viewer 8080   (then open http://localhost:8080/)");
   auto o = std::make_shared<RunOptions>();
   cmd->add_option("DATASET", o->dataset, "EuRoC/TUM-VI folder, TUM RGB-D folder, image folder or video");
   cmd->add_option("--topic", o->topic, "Instead of a DATASET: a ROS 2 sensor_msgs/msg/Image topic (e.g. /camera/image_raw)");
@@ -333,6 +365,10 @@ void addRunCommand(CLI::App& app) {
   cmd->add_option("--atlas-out", o->atlas_out, "Save the maps to an atlas file after the run");
   cmd->add_flag("--localization", o->localization, "Track against --atlas-in without mapping");
   cmd->add_flag("--verbose", o->verbose, "One line per frame instead of the progress line");
+  addViewerOptions(cmd, o->live);
+  cmd->add_flag("--viewer-wait", o->viewer_wait, "With --viewer: keep serving the page after the run, until Ctrl-C");
+  cmd->add_flag("--ros", o->live.ros, "Publish the ROS 2 visualization topics (/hiveslam/<name>/pose, path, tf, points, keyframes, status) on --domain");
+  cmd->add_option("--name", o->live.node, "With --ros or --viewer: the name in topic names and on the page")->capture_default_str();
   cmd->callback([o]() { fmt::print("{}\n", runSlam(*o).line); });
 }
 

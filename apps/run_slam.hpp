@@ -5,6 +5,7 @@
 
 #include "core/loop/loop_closer.hpp"
 #include "core/mapping/local_mapper.hpp"
+#include "apps/live_view_stack.hpp"
 #include "core/system/slam_system.hpp"
 #include <string>
 #include <vector>
@@ -27,6 +28,9 @@ struct RunOptions {
   int topic_wait_seconds = 30;  // for the first image
   // A dataset whose ground truth scores the run (for a topic, which carries none).
   std::string ground_truth;
+  // The live view (web page, ROS 2 topics); a TR node publishes the topics unless told not to.
+  LiveViewOptions live;
+  bool viewer_wait = false;  // keep serving the page after the run, until Ctrl-C
   // As the TR node of a distributed system (hiveslam node --task tr): on a DDS domain, waiting
   // for the peers it expects before the first frame.
   struct Network {

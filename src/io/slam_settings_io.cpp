@@ -131,6 +131,13 @@ KeyTable ddsKeys(communication::DdsOptions& o) {
   };
 }
 
+KeyTable viewKeys(viz::ViewSettings& v) {
+  return {
+      {"pose_hz", set(v.pose_hz)},     {"path_hz", set(v.path_hz)},   {"cloud_hz", set(v.cloud_hz)},
+      {"status_hz", set(v.status_hz)}, {"image_hz", set(v.image_hz)}, {"web_kbytes_per_s", set(v.web_kbytes_per_s)},
+  };
+}
+
 }  // namespace
 
 std::vector<std::string> settingKeys() {
@@ -143,6 +150,8 @@ std::vector<std::string> settingKeys() {
   for (const auto& [key, set] : orbKeys(slam.orb)) keys.push_back("slam.orb." + key);
   for (const auto& [key, set] : distributionKeys(distribution)) keys.push_back("distribution." + key);
   for (const auto& [key, set] : ddsKeys(dds)) keys.push_back("dds." + key);
+  viz::ViewSettings view;
+  for (const auto& [key, set] : viewKeys(view)) keys.push_back("view." + key);
   return keys;
 }
 
@@ -176,6 +185,17 @@ void applyDdsSettings(const std::filesystem::path& file, communication::DdsOptio
       o.history_depth < 1 || o.leave_flush_ms < 0)
     throw InputError(file.string() + ": dds settings out of range (max_datagram_bytes 576-65500, heartbeat_ms 1-60000, "
                      "history_depth >= 1, leave_flush_ms >= 0)");
+}
+
+void applyViewSettings(const std::filesystem::path& file, viz::ViewSettings& v) {
+  const YAML::Node section = load(file)["view"];
+  if (!section) return;
+  apply(file, section, viewKeys(v), "view.");
+  // Rates above 100 Hz would only cost CPU: no display or ROS tool draws faster.
+  const auto rate_ok = [](double hz) { return hz > 0 && hz <= 100; };
+  if (!rate_ok(v.pose_hz) || !rate_ok(v.path_hz) || !rate_ok(v.cloud_hz) || !rate_ok(v.status_hz) || !rate_ok(v.image_hz) ||
+      v.web_kbytes_per_s < 1)
+    throw InputError(file.string() + ": view settings out of range (rates above 0 and at most 100 Hz, web_kbytes_per_s >= 1)");
 }
 
 }  // namespace hiveslam::io

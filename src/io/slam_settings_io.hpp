@@ -6,6 +6,7 @@
 #include "communication/dds/dds_options.hpp"
 #include "core/system/slam_settings.hpp"
 #include "distribution/distribution_settings.hpp"
+#include "viz/view_settings.hpp"
 
 namespace hiveslam::io {
 
@@ -25,5 +26,8 @@ void applyDistributionSettings(const std::filesystem::path& file, distribution::
 // Applies the `dds:` section (max_datagram_bytes, heartbeat_ms, history_depth), checked the
 // same way and for ranges. The domain comes from the command line.
 void applyDdsSettings(const std::filesystem::path& file, communication::DdsOptions& options);
+
+// Applies the `view:` section (the live view's rates and web budget, viz::ViewSettings).
+void applyViewSettings(const std::filesystem::path& file, viz::ViewSettings& settings);
 
 }  // namespace hiveslam::io

@@ -75,10 +75,16 @@ void SlamSystem::finish() {
   if (loop_thread_.joinable()) loop_thread_.join();
 }
 
+void SlamSystem::closeLoops(const std::shared_ptr<Map>& map, const std::shared_ptr<KeyFrame>& kf) {
+  closer_.process(map, kf);
+  loops_ = closer_.stats().loops;
+  merges_ = closer_.stats().merges;
+}
+
 void SlamSystem::loopLoop() {
   while (auto job = loop_jobs_.pop()) {
     if (job->keyframe)
-      closer_.process(job->map, job->keyframe);
+      closeLoops(job->map, job->keyframe);
     else
       finalBundleAdjustment(*job->map->resolve());
     --loop_jobs_pending_;
@@ -99,7 +105,7 @@ void SlamSystem::submit(const std::shared_ptr<Map>& map, const std::shared_ptr<K
     if (!settings_.loop_closing) return;
     active_map_ = map->resolve();  // the keyframes come from where tracking is
     if (mode_ == Mode::Sequential) {
-      closer_.process(map, kf);
+      closeLoops(map, kf);
     } else {
       ++loop_jobs_pending_;
       loop_jobs_.push({map, kf});
@@ -109,7 +115,7 @@ void SlamSystem::submit(const std::shared_ptr<Map>& map, const std::shared_ptr<K
   if (mode_ == Mode::Sequential) {
     mapper_.process(map, kf, nullptr, beforeBa(map, kf));
     if (events_) events_->keyframeMapped(map, kf);
-    if (hosting_loop_closing_) closer_.process(map, kf);
+    if (hosting_loop_closing_) closeLoops(map, kf);
     return;
   }
   {
@@ -272,7 +278,10 @@ const FrameRecord& SlamSystem::process(const cv::Mat& gray, double timestamp) {
   const bool remote = !hosting_mapping_;
   const bool idle = remote ? (!remote_idle_ || remote_idle_())
                            : mode_ == Mode::Sequential || (!mapping_busy_ && jobs_.size() == 0);
-  TrackingOutput out = tracker_.track(makeFrame(gray, r.index, timestamp, extractor_, *camera_), idle);
+  Frame frame = makeFrame(gray, r.index, timestamp, extractor_, *camera_);
+  std::vector<cv::KeyPoint> keypoints;
+  if (frame_listener_) keypoints = frame.keypoints;
+  TrackingOutput out = tracker_.track(std::move(frame), idle);
   r.tracking_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   if (settings_.remeasure && out.initialization_reference) initialization_image_ = gray.clone();
   if (out.new_map) {
@@ -281,6 +290,7 @@ const FrameRecord& SlamSystem::process(const cv::Mat& gray, double timestamp) {
     if (settings_.remeasure && !initialization_image_.empty()) images_.keep(out.new_map->origin->id, initialization_image_);
     initialization_image_.release();
     addMap(out.new_map);
+    ++maps_made_;
     active_map_ = out.new_map.get();
     if (events_) events_->mapCreated(out.new_map);
   }
@@ -318,12 +328,13 @@ const FrameRecord& SlamSystem::process(const cv::Mat& gray, double timestamp) {
     } else {
       mapper_.process(tracker_.map(), out.new_keyframe, nullptr, beforeBa(tracker_.map(), out.new_keyframe));
       if (events_) events_->keyframeMapped(tracker_.map(), out.new_keyframe);
-      if (hosting_loop_closing_) closer_.process(tracker_.map(), out.new_keyframe);
+      if (hosting_loop_closing_) closeLoops(tracker_.map(), out.new_keyframe);
     }
   }
   // Lost: this frame failed where the last one tracked.
   if (events_ && !r.tracked && !records_.empty() && records_.back().tracked) events_->trackingLost();
   records_.push_back(std::move(r));
+  if (frame_listener_) frame_listener_(records_.back(), out.T_cw, keypoints, gray);
   return records_.back();
 }
 

@@ -114,6 +114,18 @@ class SlamSystem {
   // away, what it still maps changes this node's maps only).
   bool mappingIdle() const;
 
+  // Called on the tracking thread after each frame (set before the first): its record, its
+  // pose when tracked, its keypoints and image. For a live view: it must return quickly.
+  using FrameListener = std::function<void(const FrameRecord&, const Eigen::Isometry3d& T_cw,
+                                           const std::vector<cv::KeyPoint>& keypoints, const cv::Mat& gray)>;
+  void setFrameListener(FrameListener listener) { frame_listener_ = std::move(listener); }
+  // Loops closed, maps merged and maps made so far, readable from any thread while it runs
+  // (loopStats() is the loop closing thread's own until finish()).
+  struct LiveCounts {
+    int loops = 0, merges = 0, maps_made = 0;
+  };
+  LiveCounts liveCounts() const { return {loops_.load(), merges_.load(), maps_made_.load()}; }
+
   const std::vector<FrameRecord>& frames() const { return records_; }
   std::vector<std::shared_ptr<Map>> maps() const;
   int failures() const { return tracker_.failures(); }
@@ -173,6 +185,10 @@ class SlamSystem {
   // What local mapping calls before its local BA: the keyframeTriangulated event, if anyone listens.
   std::function<void()> beforeBa(const std::shared_ptr<Map>& map, const std::shared_ptr<KeyFrame>& kf) const;
   void loopLoop();
+  // Loop closing on one keyframe, then its counts published to liveCounts().
+  void closeLoops(const std::shared_ptr<Map>& map, const std::shared_ptr<KeyFrame>& kf);
+  FrameListener frame_listener_;
+  std::atomic<int> loops_{0}, merges_{0}, maps_made_{0};
   // The final global BA of `map`, with the observations measured again so far.
   void finalBundleAdjustment(Map& map);
   void waitForMapping();
