@@ -114,6 +114,7 @@ RunSummary runSlam(const RunOptions& o) {
   if (!o.times.empty()) dataset_options.times = o.times;
   std::unique_ptr<io::FrameSource> source;
   if (o.dataset.empty() == o.topic.empty()) throw InputError("give a DATASET or a --topic (one of them)");
+  if (o.live.viewer_port > 65535) throw InputError("viewer port must be 0-65535");
   if (o.topic.empty()) {
     source = io::openDataset(o.dataset, dataset_options);
   } else {

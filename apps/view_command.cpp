@@ -59,6 +59,7 @@ void addViewCommand(CLI::App& app) {
   cmd->add_option("--seconds", o->seconds, "Stop after this many seconds (default: at Ctrl-C)");
   cmd->callback([o] {
     if (o->domain < 0 || o->domain > 232) throw InputError("DDS domain must be 0-232");
+    if (o->port < 0 || o->port > 65535) throw InputError("viewer port must be 0-65535");
     serveView(*o);
   });
 }

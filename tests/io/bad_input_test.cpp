@@ -5,7 +5,11 @@
 #include <cstdio>
 #include <fstream>
 #include <opencv2/imgcodecs.hpp>
+#include <arpa/inet.h>
+#include <netinet/in.h>
+#include <sys/socket.h>
 #include <sys/wait.h>
+#include <unistd.h>
 
 #include "common/error.hpp"
 #include "io/camera_settings.hpp"
@@ -169,6 +173,31 @@ void expectOneLineFailure(const std::string& args, const std::string& expected) 
 // The command line turns every one of these into one line on stderr and a non-zero exit.
 TEST(BadInput, CommandLinePrintsOneLineAndFails) {
   expectOneLineFailure("info /nonexistent/hiveslam/dataset", "dataset not found: /nonexistent/hiveslam/dataset");
+}
+
+// The live view's commands and settings: a bad domain, port or rate is one line and an exit,
+// before anything listens.
+TEST(BadInput, TheLiveViewChecksItsDomainPortAndRates) {
+  testing::TempDir dir;
+  expectOneLineFailure("view --domain 233", "DDS domain must be 0-232");
+  expectOneLineFailure("topics --domain 233", "DDS domain must be 0-232");
+  expectOneLineFailure("view --port 70000 --seconds 1", "viewer port must be 0-65535");
+  std::ofstream(dir / "slow.yaml") << "view: {cloud_hz: 0}\n";
+  expectOneLineFailure("view --seconds 1 --config " + (dir / "slow.yaml").string(), "view settings out of range");
+  std::ofstream(dir / "typo.yaml") << "view: {cloud_hzz: 1}\n";
+  expectOneLineFailure("view --seconds 1 --config " + (dir / "typo.yaml").string(), "unknown setting 'view.cloud_hzz'");
+  // A port another program holds.
+  const int fd = socket(AF_INET, SOCK_STREAM, 0);
+  ASSERT_GE(fd, 0);
+  sockaddr_in a{};
+  a.sin_family = AF_INET;
+  a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  ASSERT_EQ(bind(fd, reinterpret_cast<sockaddr*>(&a), sizeof a), 0);
+  ASSERT_EQ(listen(fd, 1), 0);
+  socklen_t len = sizeof a;
+  ASSERT_EQ(getsockname(fd, reinterpret_cast<sockaddr*>(&a), &len), 0);
+  expectOneLineFailure("view --seconds 1 --port " + std::to_string(ntohs(a.sin_port)), "cannot listen on");
+  close(fd);
 }
 
 TEST(BadInput, ASavedBenchIsCheckedBeforeItIsRead) {
