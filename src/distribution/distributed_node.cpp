@@ -182,7 +182,7 @@ void DistributedNode::onPeer(const PeerInfo& peer, bool present) {
     onLeaving(peer);
     return;
   }
-  bool newcomer = false, restarted = false, leaving = false;
+  bool newcomer = false, restarted = false, leaving = false, rejoined = false;
   const Plan before = plan();
   {
     std::lock_guard lock(mutex_);
@@ -193,6 +193,9 @@ void DistributedNode::onPeer(const PeerInfo& peer, bool present) {
     auto it = peers_.find(peer.node);
     newcomer = it == peers_.end() || it->second.incarnation != peer.incarnation;
     restarted = it != peers_.end() && newcomer;
+    const auto gone = gone_incarnations_.find(peer.node);
+    rejoined = newcomer && gone != gone_incarnations_.end() && gone->second == peer.incarnation;
+    if (gone != gone_incarnations_.end()) gone_incarnations_.erase(gone);
     peers_[peer.node] = peer;
     had_mapping_peer_ = had_mapping_peer_ || peer.task == Task::Mapping;
   }
@@ -218,7 +221,12 @@ void DistributedNode::onPeer(const PeerInfo& peer, bool present) {
     std::lock_guard lock(mutex_);
     handover_pending_ = true;
   }
-  if (newcomer && (after.local_maps || (before.mapping && !after.mapping))) sendMapsTo(peer);
+  // A tracking node back from a partition (the same incarnation) kept its maps and mapped on
+  // alone meanwhile: its maps are newer than this node's and come here with mapping. This
+  // node's older snapshot, sent to it, would overwrite them (a 30 s cut of TR from LM and LC
+  // ended 6-100x off the uncut ATE).
+  const bool peer_is_newer = rejoined && peer.task == Task::Tracking;
+  if (newcomer && !peer_is_newer && (after.local_maps || (before.mapping && !after.mapping))) sendMapsTo(peer);
 }
 
 void DistributedNode::dropPendingGlobals(const PeerInfo& peer) {
@@ -268,6 +276,7 @@ void DistributedNode::departed(const PeerInfo& peer) {
     auto it = peers_.find(peer.node);
     // Back meanwhile as a new incarnation: that one is a peer.
     if (it == peers_.end() || it->second.incarnation != peer.incarnation) return;
+    gone_incarnations_[peer.node] = peer.incarnation;
     peers_.erase(it);
     // Stopping, or the run is over here (the gateway's Done is in): nothing is taken over.
     if (stopping_ || done_) return;

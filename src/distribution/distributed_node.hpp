@@ -13,7 +13,10 @@
 //
 // Hand-over: a node that joins the network gets the maps so far as a full snapshot, from the
 // gateway (a late LC) or from the node that mapped until it came (an LM that joins or returns
-// after TR took mapping back). Its keyframes of those maps wait for the snapshot.
+// after TR took mapping back). Its keyframes of those maps wait for the snapshot. A peer back
+// from a partition (the incarnation whose lease ran out) is a newcomer too, but a tracking node
+// back from one is sent nothing: it kept its maps and mapped on alone, so the newer maps go from
+// it, not to it (docs/RELIABILITY.md).
 //
 // Slow link: a tracking node whose gateway acknowledges its keyframes too late (GatewayWatch)
 // releases its peers (Control::Release) and runs alone from then on, as the standalone system.
@@ -203,6 +206,9 @@ class DistributedNode final : public core::SystemEvents {
   std::thread finisher_;  // the end-of-run exchange (LM, LC)
   // Peers that left and have not come back (StateIntegrator::setDeparted). Its own lock, taken
   // last: the integrator asks with a map's mutex held.
+  // Peers that departed (their lease ran out, or they left), by node: the incarnation that
+  // went. The same incarnation back is a partition that healed, not a restart. Guarded by mutex_.
+  std::map<uint16_t, uint64_t> gone_incarnations_;
   mutable std::mutex departed_mutex_;
   std::set<uint16_t> departed_;
 };
