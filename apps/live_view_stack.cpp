@@ -19,19 +19,22 @@ void addViewerOptions(CLI::App* cmd, LiveViewOptions& o) {
 LiveViewStack::LiveViewStack(const LiveViewOptions& o, core::SlamSystem& slam, std::function<nlohmann::json()> node_report,
                              std::function<bool()> publishes_map)
     : view_(std::make_unique<viz::LiveView>()) {
-  feed_ = std::make_unique<viz::LocalFeed>(*view_, o.node, slam, o.settings, std::move(node_report));
   if (o.viewer_port >= 0) {
     web_ = std::make_unique<viz::web::WebViewer>(*view_, o.viewer_host, o.viewer_port, o.settings);
     fmt::print(stderr, "live view: http://{}:{}/\n", o.viewer_host == "0.0.0.0" ? "localhost" : o.viewer_host, web_->port());
   }
   if (o.ros) ros_ = std::make_unique<viz::ros::RosVizPublisher>(*view_, o.domain, o.node, o.settings, std::move(publishes_map));
+  // Last: its thread asks the page and the topics whether anyone reads the maps.
+  feed_ = std::make_unique<viz::LocalFeed>(*view_, o.node, slam, o.settings, std::move(node_report), [this] {
+    return (web_ && web_->pages() > 0) || (ros_ && ros_->wantsMap());
+  });
 }
 
 LiveViewStack::~LiveViewStack() {
+  feed_.reset();
   ros_.reset();
   view_->close();
   web_.reset();
-  feed_.reset();
 }
 
 void LiveViewStack::finish() { feed_->stop(); }

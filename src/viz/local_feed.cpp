@@ -16,8 +16,13 @@ double processCpuSeconds() {
 }
 
 LocalFeed::LocalFeed(LiveView& view, std::string node, core::SlamSystem& slam, ViewSettings settings,
-                     std::function<nlohmann::json()> node_report)
-    : view_(view), node_(std::move(node)), slam_(slam), settings_(settings), node_report_(std::move(node_report)) {
+                     std::function<nlohmann::json()> node_report, std::function<bool()> wants_scene)
+    : view_(view),
+      node_(std::move(node)),
+      slam_(slam),
+      settings_(settings),
+      node_report_(std::move(node_report)),
+      wants_scene_(std::move(wants_scene)) {
   last_cpu_ = processCpuSeconds();
   slam_.setFrameListener([this](const core::FrameRecord& r, const Eigen::Isometry3d& T_cw,
                                 const std::vector<cv::KeyPoint>& keypoints, const cv::Mat& gray) {
@@ -72,7 +77,8 @@ void LocalFeed::run() {
   auto next_scene = Clock::now(), next_panel = Clock::now();
   while (!stop_) {
     const auto now = Clock::now();
-    if (now >= next_scene) {
+    // Unwatched, the maps are not copied: their locks stay the tracker's and mapper's.
+    if (now >= next_scene && (!wants_scene_ || wants_scene_())) {
       refreshScene(false);
       next_scene = now + every(settings_.cloud_hz);
     }

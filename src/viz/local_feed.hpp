@@ -22,8 +22,10 @@ class LocalFeed {
   // `node_report`: a distributed node's report (DistributedNode::report), read for the panel's
   // peers, tasks and traffic; empty for a standalone run. Installs the frame listener on `slam`
   // (before its first frame).
+  // `wants_scene`: whether anyone reads the maps now (a page open, a ROS reader of the points);
+  // the maps are copied only then (empty: always).
   LocalFeed(LiveView& view, std::string node, core::SlamSystem& slam, ViewSettings settings,
-            std::function<nlohmann::json()> node_report = {});
+            std::function<nlohmann::json()> node_report = {}, std::function<bool()> wants_scene = {});
   ~LocalFeed();
   LocalFeed(const LocalFeed&) = delete;
   LocalFeed& operator=(const LocalFeed&) = delete;
@@ -41,6 +43,7 @@ class LocalFeed {
   core::SlamSystem& slam_;
   ViewSettings settings_;
   std::function<nlohmann::json()> node_report_;
+  std::function<bool()> wants_scene_;
   // Tracking's counts for the panel (written on the tracking thread).
   std::mutex counts_mutex_;
   int frames_ = 0, tracked_ = 0, keyframes_made_ = 0;

@@ -70,6 +70,7 @@ void RosVizPublisher::run() {
 }
 
 void RosVizPublisher::publishOnce(State& st, bool force) {
+  map_readers_ = !writers_->points || !writers_->keyframes || hasReaders(writers_->points) || hasReaders(writers_->keyframes);
   using Clock = std::chrono::steady_clock;
   auto period = [](double hz) { return std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(1.0 / std::max(hz, 1e-3))); };
   auto& next_pose = st.next_pose;

@@ -28,6 +28,9 @@ class RosVizPublisher {
   RosVizPublisher& operator=(const RosVizPublisher&) = delete;
   // Messages written so far (all topics).
   uint64_t written() const { return written_; }
+  // Whether this node's maps go out now: it makes the map, and a reader listens to its points
+  // or keyframes (or their writers are still to be made).
+  bool wantsMap() const { return publishes_map_ && publishes_map_() && map_readers_; }
 
  private:
   // What was sent, and when each topic is next due.
@@ -49,6 +52,7 @@ class RosVizPublisher {
   std::unique_ptr<Writers> writers_;
   std::atomic<bool> stop_{false};
   std::atomic<uint64_t> written_{0};
+  std::atomic<bool> map_readers_{true};
   std::thread thread_;
 };
 

@@ -20,6 +20,7 @@ struct WebViewer::Impl {
   int port = 0;
   std::atomic<bool> stopping{false};
   std::atomic<uint64_t> bytes{0};
+  std::atomic<int> pages{0};
 
   Impl(const LiveView& v, ViewSettings s) : view(v), settings(s) {}
 };
@@ -40,14 +41,18 @@ WebViewer::WebViewer(const LiveView& view, const std::string& host, int port, Vi
   d.server.Get("/events", [&d](const httplib::Request&, httplib::Response& res) {
     auto stream = std::make_shared<ViewStream>(d.view, d.settings);
     res.set_header("Cache-Control", "no-cache");
-    res.set_chunked_content_provider("text/event-stream", [&d, stream](size_t, httplib::DataSink& sink) {
-      if (d.stopping) return false;
-      std::string out = stream->next(std::chrono::milliseconds(250));
-      // A comment line keeps the connection alive and shows a closed page within 250 ms.
-      if (out.empty()) out = ":\n\n";
-      d.bytes += out.size();
-      return sink.write(out.data(), out.size());
-    });
+    ++d.pages;
+    res.set_chunked_content_provider(
+        "text/event-stream",
+        [&d, stream](size_t, httplib::DataSink& sink) {
+          if (d.stopping) return false;
+          std::string out = stream->next(std::chrono::milliseconds(250));
+          // A comment line keeps the connection alive and shows a closed page within 250 ms.
+          if (out.empty()) out = ":\n\n";
+          d.bytes += out.size();
+          return sink.write(out.data(), out.size());
+        },
+        [&d](bool) { --d.pages; });
   });
   d.server.set_write_timeout(5, 0);
   const int bound = port == 0 ? d.server.bind_to_any_port(host) : (d.server.bind_to_port(host, port) ? port : -1);
@@ -68,5 +73,7 @@ WebViewer::~WebViewer() {
 int WebViewer::port() const { return impl_->port; }
 
 uint64_t WebViewer::bytesSent() const { return impl_->bytes; }
+
+int WebViewer::pages() const { return impl_->pages; }
 
 }  // namespace hiveslam::viz::web

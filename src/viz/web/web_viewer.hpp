@@ -21,6 +21,8 @@ class WebViewer {
   int port() const;
   // Bytes of events sent to all pages so far.
   uint64_t bytesSent() const;
+  // Pages reading the event stream now.
+  int pages() const;
 
  private:
   struct Impl;
