@@ -646,29 +646,6 @@ TEST(NodeProcesses, AFiveSecondPartitionBetweenTrackingAndMappingHeals) {
   if (HasFailure()) std::cout << nodeEvents(out.path());
 }
 
-// 30 s, from both peers: LM and LC still hear each other, TR hears neither.
-TEST(NodeProcesses, AThirtySecondPartitionFromBothPeersHeals) {
-  if (geteuid() != 0) GTEST_SKIP() << "network namespaces need root";
-  const Namespaces ns;
-  if (!ns.skipReason().empty()) GTEST_SKIP() << ns.skipReason();
-  testing::TempDir out;
-  synth::SequenceOptions o;
-  o.trajectory = "loop";
-  o.frames = 900;  // 45 s: the cut from 6 s to 36 s, then 9 s together again
-  o.seed = 5;
-  synth::writeSequence(o, out / "loop900", nullptr);
-  // At the heal TR hands its 30 s of map over while it tracks: on a loaded machine (a CI run
-  // beside a build) the acknowledgements then took over a second three times running and TR
-  // released its peers as over a slow link (a policy with its own tests). Here the heal is
-  // judged, so TR keeps offloading.
-  std::ofstream(out / "offload.yaml") << "distribution:\n  release_slow_gateway_ms: 0\n";
-  const int status = runInNamespaces(ns, out.path(), 12, kRealtime + " --config " + (out / "offload.yaml").string(),
-                                     ns.partition(6, 30, {2, 3}), out / "loop900", true);
-  ASSERT_EQ(status, 0) << nodeEvents(out.path());
-  expectHealed(out.path());
-  if (HasFailure()) std::cout << nodeEvents(out.path());
-}
-
 // TR's link carries 5 Mbit/s each way, as a slow radio link would. TR sends 1-4 Mbit/s on
 // average, in bursts of 50 KB keyframes, so it tracks worse than on a fast link; but the
 // end-of-run exchange completes and every node ends with the same map. A leaving node waited
