@@ -368,7 +368,7 @@ void addRunCommand(CLI::App& app) {
   cmd->add_flag("--verbose", o->verbose, "One line per frame instead of the progress line");
   addViewerOptions(cmd, o->live);
   cmd->add_flag("--viewer-wait", o->viewer_wait, "With --viewer: keep serving the page after the run, until Ctrl-C");
-  cmd->add_flag("--ros", o->live.ros, "Publish the ROS 2 visualization topics (/hiveslam/<name>/pose, path, tf, points, keyframes, status) on --domain");
+  cmd->add_flag("--ros", o->live.ros, "Publish the ROS 2 visualization topics (/hiveslam/<name>/pose, path, tf, points, keyframe_markers, status) on --domain");
   cmd->add_option("--name", o->live.node, "With --ros or --viewer: the name in topic names and on the page")->capture_default_str();
   cmd->callback([o]() { fmt::print("{}\n", runSlam(*o).line); });
 }
