@@ -90,7 +90,10 @@ void RosVizPublisher::publishOnce(State& st, bool force) {
     std::vector<PathPose> path;
     std::shared_ptr<const MapScene> scene;
     std::optional<nlohmann::json> panel;
-    const bool pose_due = force || now >= next_pose, path_due = force || now >= next_path,
+    // The path is copied only for a listening reader: it grows with every tracked frame, and
+    // the copy is made under the view's lock, which the tracking thread takes once a frame.
+    const bool path_wanted = (force || now >= next_path) && writers_->path && hasReaders(writers_->path);
+    const bool pose_due = force || now >= next_pose,
                cloud_due = force || now >= next_cloud, status_due = force || now >= next_status;
     view_.read([&](const std::map<std::string, NodeState>& nodes) {
       const auto it = nodes.find(node_);
@@ -101,7 +104,7 @@ void RosVizPublisher::publishOnce(State& st, bool force) {
         pose = PathPose{n.frame->timestamp, n.frame->map, n.frame->T_wc};
         pose_version = n.frame_version;
       }
-      if (path_due && n.path.size() != path_size) {
+      if (path_wanted && n.path.size() != path_size) {
         path = n.path;
         path_size = n.path.size();
       }
@@ -116,6 +119,7 @@ void RosVizPublisher::publishOnce(State& st, bool force) {
     });
     if (pose) {
       next_pose = now + period(settings_.pose_hz);
+      writers_->pathWriter();  // the path's topic appears with the first pose
       if (hasReaders(writers_->posesWriter())) {
         auto m = toPoseStamped(*pose);
         writers_->posesWriter()->write(&m);
@@ -129,11 +133,9 @@ void RosVizPublisher::publishOnce(State& st, bool force) {
     }
     if (!path.empty()) {
       next_path = now + period(settings_.path_hz);
-      if (hasReaders(writers_->pathWriter())) {
-        auto m = toPath(path, path.back().timestamp);
-        writers_->path->write(&m);
-        ++written_;
-      }
+      auto m = toPath(path, path.back().timestamp);
+      writers_->path->write(&m);
+      ++written_;
     }
     if (scene) {
       next_cloud = now + period(settings_.cloud_hz);
