@@ -1,5 +1,6 @@
 // hiveslam: one program for every node and every tool; see `hiveslam --help`.
 #include <glog/logging.h>
+#include <spdlog/cfg/env.h>
 #include <spdlog/spdlog.h>
 
 #include <cstdio>
@@ -20,6 +21,8 @@ int main(int argc, char** argv) {
   // Ceres logs through glog; its warnings (a rejected LM step) are routine, not for users.
   FLAGS_minloglevel = google::GLOG_ERROR;
   google::InitGoogleLogging(argv[0]);
+  // SPDLOG_LEVEL=debug: each packet sent and received, with its topic, kind, map and size.
+  spdlog::cfg::load_env_levels();
   CLI::App app{"hiveslam: self-organizing distributed monocular visual SLAM"};
   app.require_subcommand(1);
   app.footer("Example:\n  hiveslam demo                 (render a sequence, run it on 1 and 3 nodes)\n"

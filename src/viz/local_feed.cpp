@@ -77,9 +77,11 @@ void LocalFeed::run() {
   auto next_scene = Clock::now(), next_panel = Clock::now();
   while (!stop_) {
     const auto now = Clock::now();
-    // Unwatched, the maps are not copied: their locks stay the tracker's and mapper's.
-    if (now >= next_scene && (!wants_scene_ || wants_scene_())) {
-      refreshScene(false);
+    // Unwatched, the maps are not copied: their locks stay the tracker's and mapper's. Whether
+    // anyone watches is asked again at the scene's rate (the next time must move on either way:
+    // left in the past, this loop spun and took 40-50% of a core in every node).
+    if (now >= next_scene) {
+      if (!wants_scene_ || wants_scene_()) refreshScene(false);
       next_scene = now + every(settings_.cloud_hz);
     }
     if (now >= next_panel) {

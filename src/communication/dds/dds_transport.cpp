@@ -158,6 +158,8 @@ struct DdsTransport::Impl : public dds::DomainParticipantListener {
         m.raw_size = p.raw_size();
         m.body = std::move(p.body());
         impl->counter.received(topic, m.wireSize());
+        spdlog::debug("node {}: in  {} kind {} from {} map {} seq {} {} B", impl->self_node.load(), topicName(topic), m.kind,
+                      m.source, m.map, m.seq, m.wireSize());
         handler(std::move(m));
       }
     }
@@ -371,6 +373,8 @@ void DdsTransport::publish(Topic topic, Message&& m) {
   if (d.closed) return;
   if (d.writerFor(topic)->write(&p)) {
     d.counter.sent(topic, bytes);
+    spdlog::debug("node {}: out {} kind {} map {} seq {} {} B", d.self_node.load(), topicName(topic), p.kind(), p.map_id(),
+                  p.seq(), bytes);
   } else {
     d.counter.writeFailed(topic);
     spdlog::warn("node {}: a write on {} failed ({} bytes)", d.self_node.load(), topicName(topic), bytes);
