@@ -6,7 +6,7 @@ BUILD ?= build
 JOBS ?= $(shell nproc)
 CMAKE_FLAGS ?=
 
-.PHONY: setup build demo test check asan tsan bench clean
+.PHONY: setup build demo test check asan tsan fuzz bench clean
 
 setup:
 	bash scripts/setup
@@ -18,7 +18,7 @@ build:
 demo: setup build
 	./$(BUILD)/apps/hiveslam demo --out demo_out
 
-test: setup check
+test: setup check fuzz
 
 check: build
 	cd $(BUILD) && ctest --output-on-failure -j $(JOBS)
@@ -31,8 +31,13 @@ asan:
 tsan:
 	$(MAKE) check BUILD=build-tsan CMAKE_FLAGS="-DHIVESLAM_TSAN=ON -DCMAKE_BUILD_TYPE=RelWithDebInfo -DHIVESLAM_BUILD_BENCH=OFF"
 
+# The libFuzzer targets, FUZZ_SECONDS each (fuzz/, built with clang in build-fuzz).
+FUZZ_SECONDS ?= 10
+fuzz:
+	bash scripts/fuzz $(FUZZ_SECONDS)
+
 bench: build
 	./$(BUILD)/bench/render_bench
 
 clean:
-	rm -rf build build-asan build-tsan demo_out
+	rm -rf build build-asan build-tsan build-fuzz demo_out

@@ -74,7 +74,7 @@ DistributedNode::DistributedNode(core::SlamSystem& slam, communication::Transpor
     integrator_.applyAhead(m);  // its new points, until the whole record can go in
     return true;
   };
-  hooks.global = [this](std::vector<MapRecord>&& b, Topic t) { onGlobal(std::move(b), t); };
+  hooks.global = [this](std::vector<MapRecord>&& b, Topic t, uint16_t source) { onGlobal(std::move(b), t, source); };
   hooks.local_applied = [this](const MapRecord& m) {
     {
       std::lock_guard lock(mutex_);
@@ -196,6 +196,10 @@ void DistributedNode::onPeer(const PeerInfo& peer, bool present) {
     const auto gone = gone_incarnations_.find(peer.node);
     rejoined = newcomer && gone != gone_incarnations_.end() && gone->second == peer.incarnation;
     if (gone != gone_incarnations_.end()) gone_incarnations_.erase(gone);
+    if (rejoined && peer.task == Task::Tracking && options_.task != Task::Tracking)
+      adopt_from_[peer.node].clear();
+    else if (newcomer)
+      adopt_from_.erase(peer.node);
     peers_[peer.node] = peer;
     had_mapping_peer_ = had_mapping_peer_ || peer.task == Task::Mapping;
   }

@@ -116,7 +116,7 @@ class DistributedNode final : public core::SystemEvents {
   void departed(const communication::PeerInfo& peer);
   void dropPendingGlobals(const communication::PeerInfo& peer);
   void applyPlan();
-  void onGlobal(std::vector<MapRecord>&& batches, communication::Topic topic);
+  void onGlobal(std::vector<MapRecord>&& batches, communication::Topic topic, uint16_t source);
   void onControl(const communication::Message& m, communication::Topic topic);
   // The gateway's part of the end of a run. Returns whether the LC (if any) answered.
   bool finishAsGateway();
@@ -204,11 +204,14 @@ class DistributedNode final : public core::SystemEvents {
   uint64_t knownEpoch(core::Id map) const;  // the newer of synced_ and published_; mutex_ held
   void releaseHeld(core::Id map);           // applies the held local maps the epoch has reached
   std::thread finisher_;  // the end-of-run exchange (LM, LC)
-  // Peers that left and have not come back (StateIntegrator::setDeparted). Its own lock, taken
-  // last: the integrator asks with a map's mutex held.
   // Peers that departed (their lease ran out, or they left), by node: the incarnation that
   // went. The same incarnation back is a partition that healed, not a restart. Guarded by mutex_.
   std::map<uint16_t, uint64_t> gone_incarnations_;
+  // LM, LC: tracking nodes back from a partition, by node, and the maps already taken whole
+  // from them (the first global map of each: StateIntegrator::adoptGlobal). Guarded by mutex_.
+  std::map<uint16_t, std::set<core::Id>> adopt_from_;
+  // Peers that left and have not come back (StateIntegrator::setDeparted). Its own lock, taken
+  // last: the integrator asks with a map's mutex held.
   mutable std::mutex departed_mutex_;
   std::set<uint16_t> departed_;
 };

@@ -452,7 +452,7 @@ void MapHandler::handleIncoming(communication::Message& msg, Topic topic) {
       integrator_.applyLocal(m);
       if (hooks_.local_applied) hooks_.local_applied(m);
     } else if (auto all = observer_.collectGlobal(std::move(m), msg.source)) {
-      if (hooks_.global) hooks_.global(std::move(*all), topic);
+      if (hooks_.global) hooks_.global(std::move(*all), topic, msg.source);
     }
   } catch (const std::exception& e) {
     ++dropped_;

@@ -37,8 +37,8 @@ class MapHandler {
     // global update that is still on its way here): the hook keeps it and returns true. Its
     // poses are in the new frame; applied now, the global update would correct them twice.
     std::function<bool(const MapRecord&)> hold;
-    // Incoming global map, complete (all batches), from `topic`.
-    std::function<void(std::vector<MapRecord>&&, communication::Topic)> global;
+    // Incoming global map, complete (all batches), from `topic`, sent by node `source`.
+    std::function<void(std::vector<MapRecord>&&, communication::Topic, uint16_t source)> global;
     std::function<void(const MapRecord&)> local_applied;
     // A control packet, in order with the maps of its topic.
     std::function<void(const communication::Message&, communication::Topic)> control;

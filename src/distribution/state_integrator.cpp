@@ -401,13 +401,22 @@ void StateIntegrator::applyAhead(const MapRecord& m) {
     if (!kf->bad) kf->updateConnections();
 }
 
-bool StateIntegrator::applyGlobal(const std::vector<MapRecord>& batches, bool authoritative) {
+void StateIntegrator::adoptGlobal(const std::vector<MapRecord>& batches) {
+  if (batches.empty()) return;
+  {
+    std::lock_guard lock(epochs_mutex_);
+    epochs_.erase(batches.front().map);
+  }
+  applyGlobal(batches, true, true);
+}
+
+bool StateIntegrator::applyGlobal(const std::vector<MapRecord>& batches, bool authoritative, bool whole) {
   if (batches.empty()) return false;
   const uint64_t epoch = batches.front().epoch;
   // LC's relay, labelled with LC's latest published update, can still be older than LC's map:
   // a merge or loop correction is in the map from the moment it is made and gets its label a
   // moment later. Taken, it erased the merged map's keyframes (CI: 11.6% ATE).
-  const auto left = [&](const core::Map& m) { return authoritative && stale(m, epoch); };
+  const auto left = [&](const core::Map& m) { return authoritative && !whole && stale(m, epoch); };
   if (auto m = slam_.findMap(batches.front().map)) {
     std::lock_guard lock(m->mutex);
     if (left(*m)) return false;

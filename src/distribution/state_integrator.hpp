@@ -66,7 +66,11 @@ class StateIntegrator {
   // or only what a stale local map gives, when it is authoritative but its label stands for
   // a frame the map has left (a correction made here since, its update not yet out): the
   // caller treats it as an ignored update.
-  bool applyGlobal(const std::vector<MapRecord>& batches, bool authoritative);
+  bool applyGlobal(const std::vector<MapRecord>& batches, bool authoritative) { return applyGlobal(batches, authoritative, false); }
+  // All batches of one global map, taken whole whatever its label, and the map's earlier labels
+  // forgotten: the map of a tracking node back from a partition. It mapped on alone while this
+  // node's labels went on without it, so one label can stand for two frames on the two sides.
+  void adoptGlobal(const std::vector<MapRecord>& batches);
   uint64_t stalePointsCarried() const { return stale_points_carried_; }
   // Whether a node has left the network (and not come back). An authoritative map spares the
   // points its sender may not have heard of yet; a node that left sends none any more, so its
@@ -81,6 +85,7 @@ class StateIntegrator {
   uint64_t label(const core::Map& map) const;
 
  private:
+  bool applyGlobal(const std::vector<MapRecord>& batches, bool authoritative, bool whole);
   std::shared_ptr<core::Map> mapFor(Id id);
   // `authoritative`: the record may bring back a point erased here (see Observer::erasedPoint).
   // Returns whether the map holds the point now: only then does S_full record it.

@@ -83,8 +83,11 @@ class FeatureGrid {
   double lo_x_ = 0, hi_x_ = 0, lo_y_ = 0, hi_y_ = 0;  // the points' own extent
   std::vector<int> start_;  // kCols * kRows + 1 offsets into index_
   std::vector<int> index_;  // point indices grouped by cell
-  int cellX(double x) const { return std::clamp(static_cast<int>(std::floor((x - min_x_) * inv_w_)), 0, kCols - 1); }
-  int cellY(double y) const { return std::clamp(static_cast<int>(std::floor((y - min_y_) * inv_h_)), 0, kRows - 1); }
+  // Clamped before the cast: a double beyond int's range (or not a number) cast to int is
+  // undefined (fuzz/wire_fuzzer reached it with a point at -1.6e28 in a received keyframe).
+  static int cell(double c, int cells) { return c >= 0 ? (c < cells ? static_cast<int>(c) : cells - 1) : 0; }
+  int cellX(double x) const { return cell(std::floor((x - min_x_) * inv_w_), kCols); }
+  int cellY(double y) const { return cell(std::floor((y - min_y_) * inv_h_), kRows); }
 };
 
 }  // namespace hiveslam::core

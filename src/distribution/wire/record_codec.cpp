@@ -53,6 +53,8 @@ PointRecord getPoint(ByteReader& r, uint64_t& previous_id) {
   for (int i = 0; i < 3; ++i) p.normal[i] = r.get<float>();
   p.min_distance = r.get<float>();
   p.max_distance = r.get<float>();
+  if (!p.normal.allFinite() || !std::isfinite(p.min_distance) || !std::isfinite(p.max_distance))
+    throw WireError("bad point normal or distances");
   return p;
 }
 
@@ -138,6 +140,9 @@ KeyFrameRecord getKeyframe(ByteReader& r) {
   f.width = r.get<int32_t>();
   f.height = r.get<int32_t>();
   if (f.width <= 0 || f.height <= 0 || f.width > 100000 || f.height > 100000) throw WireError("bad image size");
+  if (!std::isfinite(f.timestamp) || !std::isfinite(f.K.fx) || !std::isfinite(f.K.fy) || !std::isfinite(f.K.cx) ||
+      !std::isfinite(f.K.cy) || f.K.fx <= 0 || f.K.fy <= 0)
+    throw WireError("bad timestamp or intrinsics");
   k.made_in_epoch = r.get<uint64_t>();
   k.made_from = r.get<Id>();
   k.T_made_from = getPose(r);
@@ -153,6 +158,11 @@ KeyFrameRecord getKeyframe(ByteReader& r) {
     kp.octave = r.get<uint8_t>();
     if (kp.octave > 31) throw WireError("bad keypoint level");
     const float x = r.get<float>(), y = r.get<float>();
+    // Not a number, a point would be put in a grid cell by an undefined cast (found by
+    // fuzz/wire_fuzzer). A keypoint was detected in the image; its undistorted point may lie
+    // outside it (a wide lens), and only has to be a number.
+    const bool in_image = kp.pt.x >= -1 && kp.pt.y >= -1 && kp.pt.x <= f.width + 1 && kp.pt.y <= f.height + 1;
+    if (!in_image || !std::isfinite(kp.angle) || !std::isfinite(x) || !std::isfinite(y)) throw WireError("bad keypoint");
     f.points[i] = Eigen::Vector2d(x, y);
     r.bytes(f.descriptors.ptr<uint8_t>(static_cast<int>(i)), 32);
   }
