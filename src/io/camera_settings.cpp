@@ -62,11 +62,24 @@ YAML::Node loadYaml(const std::filesystem::path& path) {
   std::string text, line;
   while (std::getline(in, line))
     if (line.rfind('%', 0) != 0) text += line + "\n";
+  YAML::Node root;
   try {
-    return YAML::Load(text);
+    root = YAML::Load(text);
   } catch (const YAML::Exception& e) {
     throw InputError(fmt::format("{}:{}: YAML error: {}", path.string(), e.mark.line + 1, e.msg));
   }
+  // A map of keys, or yaml-cpp's own exceptions would follow on the first lookup, without the
+  // file's name (a fuzzer finding: a file holding one word).
+  if (root.IsNull()) return YAML::Node(YAML::NodeType::Map);
+  if (!root.IsMap()) throw InputError(path.string() + ": not a YAML map of keys");
+  return root;
+}
+
+// A nested map (`camera:`, `T_BS:`), checked like the file itself.
+YAML::Node mapAt(const YAML::Node& parent, const std::string& key, const std::filesystem::path& path) {
+  const YAML::Node node = parent[key];
+  if (node && !node.IsMap()) throw InputError(path.string() + ": '" + key + "' is not a map of keys");
+  return node;
 }
 
 template <typename T>
@@ -97,10 +110,11 @@ bool hasCameraSection(const std::filesystem::path& path) { return static_cast<bo
 
 CameraSettings loadSettingsCamera(const std::filesystem::path& path) {
   const YAML::Node root = loadYaml(path);
-  const YAML::Node cam = root["camera"];
+  const YAML::Node cam = mapAt(root, "camera", path);
   if (!cam) throw InputError(path.string() + ": no 'camera' section");
   for (const auto& kv : cam) {
-    const auto key = kv.first.as<std::string>();
+    if (!kv.first.IsScalar()) throw InputError(path.string() + ": a key in 'camera' is not a name");
+    const auto key = kv.first.Scalar();
     if (std::find(cameraSettingKeys().begin(), cameraSettingKeys().end(), key) == cameraSettingKeys().end())
       throw InputError(path.string() + ": unknown setting 'camera." + key + "'");
   }
@@ -131,8 +145,8 @@ CameraSettings loadEurocSensorYaml(const std::filesystem::path& path) {
   CameraSettings s;
   s.camera = makeCamera(model, resolution[0], resolution[1], intrinsics, distortion, path.string());
   s.fps = optional<double>(root, "rate_hz", 0.0, path);
-  if (root["T_BS"]) {
-    const auto data = required<std::vector<double>>(root["T_BS"], "data", path);
+  if (const YAML::Node t_bs = mapAt(root, "T_BS", path)) {
+    const auto data = required<std::vector<double>>(t_bs, "data", path);
     if (data.size() != 16)
       throw InputError(fmt::format("{}: T_BS needs 16 values, got {}", path.string(), data.size()));
     Eigen::Matrix4d M;
@@ -159,6 +173,10 @@ CameraSettings loadCalibTxt(const std::filesystem::path& path) {
     for (const char* key : {"k1", "k2", "p1", "p2"}) distortion.push_back(get(key));
     if (kv.count("k3")) distortion.push_back(get("k3"));
   }
+  // Checked before the casts: a width of 1e30 or NaN has no int (UB, a fuzzer finding).
+  for (const char* key : {"width", "height"})
+    if (!(get(key) >= 1 && get(key) <= 100000))
+      throw InputError(fmt::format("{}: '{}' must be 1 to 100000 pixels", path.string(), key));
   CameraSettings s;
   s.camera = makeCamera("pinhole", static_cast<int>(get("width")), static_cast<int>(get("height")),
                         {get("fx"), get("fy"), get("cx"), get("cy")}, distortion, path.string());

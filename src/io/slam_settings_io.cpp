@@ -19,19 +19,29 @@ std::function<void(const YAML::Node&)> set(T& field) {
 
 using KeyTable = std::map<std::string, std::function<void(const YAML::Node&)>>;
 
+// A settings file is a map of sections (an empty file is an empty map). Anything else would
+// make yaml-cpp throw its own exceptions on the first lookup, without the file's name (a
+// fuzzer finding: a file holding one word).
 YAML::Node load(const std::filesystem::path& file) {
+  YAML::Node root;
   try {
-    return YAML::LoadFile(file.string());
+    root = YAML::LoadFile(file.string());
   } catch (const YAML::Exception& e) {
     throw InputError(file.string() + ": " + e.msg);
   }
+  if (root.IsNull()) return YAML::Node(YAML::NodeType::Map);
+  if (!root.IsMap()) throw InputError(file.string() + ": not a settings file (a YAML map of sections)");
+  return root;
 }
 
 // Sets every key of `section` through `table`; `skip` is a sub-section handled elsewhere.
 void apply(const std::filesystem::path& file, const YAML::Node& section, const KeyTable& table,
            const std::string& prefix, const std::string& skip = "") {
+  const std::string name = prefix.empty() ? std::string("slam") : prefix.substr(0, prefix.size() - 1);
+  if (!section.IsMap()) throw InputError(file.string() + ": '" + name + "' is not a map of settings");
   for (const auto& kv : section) {
-    const std::string key = kv.first.as<std::string>();
+    if (!kv.first.IsScalar()) throw InputError(file.string() + ": a key in '" + name + "' is not a name");
+    const std::string key = kv.first.Scalar();
     if (key == skip) continue;
     const auto it = table.find(key);
     if (it == table.end()) throw InputError(file.string() + ": unknown setting '" + prefix + key + "'");
@@ -65,6 +75,7 @@ KeyTable slamKeys(core::SlamSettings& s) {
       {"triangulation_by_vocabulary", set(s.triangulation_by_vocabulary)},
       {"fusion_neighbours", set(s.fusion_neighbours)},
       {"local_ba_iterations", set(s.local_ba_iterations)},
+      {"keyframe_queue", set(s.keyframe_queue)},
       {"redundant_keyframe_ratio", set(s.redundant_keyframe_ratio)},
       {"keyframe_culling_max_angle_deg", set(s.keyframe_culling_max_angle_deg)},
       {"loop_closing", set(s.loop_closing)},
@@ -161,6 +172,14 @@ void applySlamSettings(const std::filesystem::path& file, core::SlamSettings& s)
   if (!slam) return;
   apply(file, slam, slamKeys(s), "", "orb");
   if (slam["orb"]) apply(file, slam["orb"], orbKeys(s.orb), "orb.");
+  // The extractor divides by the cell size and indexes its pyramid by level: out of these
+  // ranges it reads outside its buffers (fuzzer findings: levels 0, cell_size 0 and -7).
+  const auto& o = s.orb;
+  if (o.features < 1 || o.levels < 1 || o.levels > 32 || !(o.scale_factor >= 1.0 && o.scale_factor <= 4.0) ||
+      o.fast_threshold < 1 || o.fast_threshold > 255 || o.min_fast_threshold < 1 || o.min_fast_threshold > 255 ||
+      o.cell_size < 8 || o.cell_size > 1024)
+    throw InputError(file.string() + ": slam.orb settings out of range (features >= 1, levels 1-32, scale_factor 1-4, "
+                     "FAST thresholds 1-255, cell_size 8-1024)");
 }
 
 void applyDistributionSettings(const std::filesystem::path& file, distribution::DistributionSettings& s) {

@@ -278,4 +278,38 @@ TEST(BadInput, AnUnknownCameraKeyIsNamed) {
   EXPECT_NE(errorOf([&] { loadSettingsCamera(file); }).find("unknown setting 'camera.focal'"), std::string::npos);
 }
 
+// Fuzzer findings (fuzz/settings_fuzzer.cpp): files that are not maps of keys escaped as
+// yaml-cpp's own exceptions without the file's name, and ORB settings and a calibration size
+// out of range read outside buffers or cast a value no int holds.
+TEST(BadInput, SettingsFilesThatAreNotMapsOrOutOfRangeAreNamed) {
+  testing::TempDir dir;
+  const fs::path file = dir / "settings.yaml";
+  const auto slamError = [&](const std::string& text) {
+    std::ofstream(file) << text;
+    core::SlamSettings s;
+    return errorOf([&] { applySlamSettings(file, s); });
+  };
+  for (const std::string text : {"T\n", "- 1\n", "slam: 5\n", "slam: [1, 2]\n", "slam:\n  [a]: 1\n", "slam:\n  orb: 3\n"})
+    EXPECT_NE(slamError(text).find("settings.yaml"), std::string::npos) << text;
+  for (const std::string bad : {"levels: 0", "cell_size: 0", "cell_size: -7", "scale_factor: 0.5", "features: 0"})
+    EXPECT_NE(slamError("slam:\n  orb:\n    " + bad + "\n").find("out of range"), std::string::npos) << bad;
+  std::ofstream(file) << "";
+  core::SlamSettings untouched;
+  applySlamSettings(file, untouched);  // an empty file sets nothing
+  EXPECT_EQ(untouched.orb.levels, 8);
+  std::ofstream(file) << "dds: 1\n";
+  communication::DdsOptions dds;
+  EXPECT_NE(errorOf([&] { applyDdsSettings(file, dds); }).find("'dds' is not a map"), std::string::npos);
+  std::ofstream(file) << "camera: pinhole\n";
+  EXPECT_NE(errorOf([&] { loadSettingsCamera(file); }).find("'camera' is not a map"), std::string::npos);
+  std::ofstream(file) << "just words\n";
+  EXPECT_NE(errorOf([&] { loadCameraFile(file); }).find("settings.yaml: not a YAML map"), std::string::npos);
+  std::ofstream(file) << "resolution: [64, 48]\nintrinsics: [50, 50, 32, 24]\nT_BS: 7\n";
+  EXPECT_NE(errorOf([&] { loadEurocSensorYaml(file); }).find("'T_BS' is not a map"), std::string::npos);
+  std::ofstream(dir / "calib.txt") << "width 1e30\nheight 40\nfx 50\nfy 50\ncx 40\ncy 20\n";
+  EXPECT_NE(errorOf([&] { loadCalibTxt(dir / "calib.txt"); }).find("'width' must be"), std::string::npos);
+  std::ofstream(dir / "calib.txt") << "width nan\nheight 40\nfx 50\nfy 50\ncx 40\ncy 20\n";
+  EXPECT_NE(errorOf([&] { loadCalibTxt(dir / "calib.txt"); }).find("calib.txt"), std::string::npos);
+}
+
 }  // namespace hiveslam::io

@@ -277,7 +277,8 @@ const FrameRecord& SlamSystem::process(const cv::Mat& gray, double timestamp) {
   r.timestamp = timestamp;
   const bool remote = !hosting_mapping_;
   const bool idle = remote ? (!remote_idle_ || remote_idle_())
-                           : mode_ == Mode::Sequential || (!mapping_busy_ && jobs_.size() == 0);
+                           : mode_ == Mode::Sequential || (!mapping_busy_ && jobs_.size() == 0) ||
+                                 jobs_.size() < static_cast<size_t>(settings_.keyframe_queue);
   Frame frame = makeFrame(gray, r.index, timestamp, extractor_, *camera_);
   std::vector<cv::KeyPoint> keypoints;
   if (frame_listener_) keypoints = frame.keypoints;
