@@ -17,14 +17,14 @@ class TopicFrameSource final : public io::FrameSource {
   TopicFrameSource(int domain, const std::string& ros_topic, io::CameraSettings camera,
                    std::chrono::milliseconds first_wait, std::chrono::milliseconds idle);
 
-  // Throws InputError on an image of another size than the calibration's or an encoding it
-  // cannot read; drops malformed images with a warning.
+  // Drops, with a warning, images it cannot read and images of another size than the
+  // calibration's (counted in dropped()).
   std::optional<io::Frame> next() override;
   std::optional<size_t> size() const override { return std::nullopt; }
   const io::CameraSettings& camera() const override { return camera_; }
   const std::optional<io::Trajectory>& groundTruth() const override { return no_truth_; }
   std::string describe() const override;
-  uint64_t dropped() const { return reader_ ? reader_->dropped() : 0; }
+  uint64_t dropped() const { return (reader_ ? reader_->dropped() : 0) + malformed_; }
 
  private:
   std::string topic_;
@@ -36,10 +36,7 @@ class TopicFrameSource final : public io::FrameSource {
   std::chrono::milliseconds first_wait_, idle_;
   std::optional<io::Trajectory> no_truth_;
   size_t index_ = 0;
+  uint64_t malformed_ = 0;
 };
-
-// CameraImage -> 8-bit grey (mono8, mono16, rgb8, bgr8, rgba8, bgra8); an empty Mat when the
-// sizes do not add up (a malformed message, dropped); InputError for another encoding.
-cv::Mat toGray(const communication::CameraImage& image);
 
 }  // namespace hiveslam::apps
