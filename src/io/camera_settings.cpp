@@ -14,6 +14,7 @@
 #include "core/camera/kannala_brandt.hpp"
 #include "core/camera/pinhole_radtan.hpp"
 #include "io/text_table.hpp"
+#include "io/yaml_file.hpp"
 
 namespace hiveslam::io {
 
@@ -55,33 +56,6 @@ std::shared_ptr<const camera::CameraModel> makeCamera(const std::string& model, 
 
 namespace {
 
-YAML::Node loadYaml(const std::filesystem::path& path) {
-  if (!std::filesystem::exists(path)) throw InputError("settings file not found: " + path.string());
-  // OpenCV-written files start with "%YAML:1.0", which YAML parsers reject: drop directives.
-  std::ifstream in(path);
-  std::string text, line;
-  while (std::getline(in, line))
-    if (line.rfind('%', 0) != 0) text += line + "\n";
-  YAML::Node root;
-  try {
-    root = YAML::Load(text);
-  } catch (const YAML::Exception& e) {
-    throw InputError(fmt::format("{}:{}: YAML error: {}", path.string(), e.mark.line + 1, e.msg));
-  }
-  // A map of keys, or yaml-cpp's own exceptions would follow on the first lookup, without the
-  // file's name (a fuzzer finding: a file holding one word).
-  if (root.IsNull()) return YAML::Node(YAML::NodeType::Map);
-  if (!root.IsMap()) throw InputError(path.string() + ": not a YAML map of keys");
-  return root;
-}
-
-// A nested map (`camera:`, `T_BS:`), checked like the file itself.
-YAML::Node mapAt(const YAML::Node& parent, const std::string& key, const std::filesystem::path& path) {
-  const YAML::Node node = parent[key];
-  if (node && !node.IsMap()) throw InputError(path.string() + ": '" + key + "' is not a map of keys");
-  return node;
-}
-
 template <typename T>
 T required(const YAML::Node& node, const std::string& key, const std::filesystem::path& path) {
   if (!node[key]) throw InputError(path.string() + ": missing key '" + key + "'");
@@ -106,10 +80,10 @@ const std::vector<std::string>& cameraSettingKeys() {
   return keys;
 }
 
-bool hasCameraSection(const std::filesystem::path& path) { return static_cast<bool>(loadYaml(path)["camera"]); }
+bool hasCameraSection(const std::filesystem::path& path) { return static_cast<bool>(loadYamlMap(path)["camera"]); }
 
 CameraSettings loadSettingsCamera(const std::filesystem::path& path) {
-  const YAML::Node root = loadYaml(path);
+  const YAML::Node root = loadYamlMap(path);
   const YAML::Node cam = mapAt(root, "camera", path);
   if (!cam) throw InputError(path.string() + ": no 'camera' section");
   for (const auto& kv : cam) {
@@ -131,7 +105,7 @@ CameraSettings loadSettingsCamera(const std::filesystem::path& path) {
 }
 
 CameraSettings loadEurocSensorYaml(const std::filesystem::path& path) {
-  const YAML::Node root = loadYaml(path);
+  const YAML::Node root = loadYamlMap(path);
   const auto resolution = required<std::vector<int>>(root, "resolution", path);
   if (resolution.size() != 2)
     throw InputError(fmt::format("{}: 'resolution' needs 2 values, got {}", path.string(),
@@ -186,7 +160,7 @@ CameraSettings loadCalibTxt(const std::filesystem::path& path) {
 
 CameraSettings loadCameraFile(const std::filesystem::path& path) {
   if (path.extension() == ".txt") return loadCalibTxt(path);
-  return loadYaml(path)["camera"] ? loadSettingsCamera(path) : loadEurocSensorYaml(path);
+  return loadYamlMap(path)["camera"] ? loadSettingsCamera(path) : loadEurocSensorYaml(path);
 }
 
 void writeSettingsCamera(const std::filesystem::path& path, const camera::CameraModel& camera,

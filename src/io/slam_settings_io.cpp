@@ -7,6 +7,7 @@
 
 #include "common/error.hpp"
 #include "io/camera_settings.hpp"
+#include "io/yaml_file.hpp"
 
 namespace hiveslam::io {
 
@@ -18,21 +19,6 @@ std::function<void(const YAML::Node&)> set(T& field) {
 }
 
 using KeyTable = std::map<std::string, std::function<void(const YAML::Node&)>>;
-
-// A settings file is a map of sections (an empty file is an empty map). Anything else would
-// make yaml-cpp throw its own exceptions on the first lookup, without the file's name (a
-// fuzzer finding: a file holding one word).
-YAML::Node load(const std::filesystem::path& file) {
-  YAML::Node root;
-  try {
-    root = YAML::LoadFile(file.string());
-  } catch (const YAML::Exception& e) {
-    throw InputError(file.string() + ": " + e.msg);
-  }
-  if (root.IsNull()) return YAML::Node(YAML::NodeType::Map);
-  if (!root.IsMap()) throw InputError(file.string() + ": not a settings file (a YAML map of sections)");
-  return root;
-}
 
 // Sets every key of `section` through `table`; `skip` is a sub-section handled elsewhere.
 void apply(const std::filesystem::path& file, const YAML::Node& section, const KeyTable& table,
@@ -167,7 +153,7 @@ std::vector<std::string> settingKeys() {
 }
 
 void applySlamSettings(const std::filesystem::path& file, core::SlamSettings& s) {
-  const YAML::Node root = load(file);
+  const YAML::Node root = loadYamlMap(file);
   const YAML::Node slam = root["slam"];
   if (!slam) return;
   apply(file, slam, slamKeys(s), "", "orb");
@@ -183,7 +169,7 @@ void applySlamSettings(const std::filesystem::path& file, core::SlamSettings& s)
 }
 
 void applyDistributionSettings(const std::filesystem::path& file, distribution::DistributionSettings& s) {
-  const YAML::Node section = load(file)["distribution"];
+  const YAML::Node section = loadYamlMap(file)["distribution"];
   if (!section) return;
   apply(file, section, distributionKeys(s), "distribution.");
   if (s.local_first_batch < 1 || s.local_max_batch < s.local_first_batch || s.global_batch < 1 ||
@@ -196,7 +182,7 @@ void applyDistributionSettings(const std::filesystem::path& file, distribution::
 }
 
 void applyDdsSettings(const std::filesystem::path& file, communication::DdsOptions& o) {
-  const YAML::Node section = load(file)["dds"];
+  const YAML::Node section = loadYamlMap(file)["dds"];
   if (!section) return;
   apply(file, section, ddsKeys(o), "dds.");
   // 576 bytes: the datagram every IPv4 host must take whole; 65500: UDP's limit.
@@ -207,7 +193,7 @@ void applyDdsSettings(const std::filesystem::path& file, communication::DdsOptio
 }
 
 void applyViewSettings(const std::filesystem::path& file, viz::ViewSettings& v) {
-  const YAML::Node section = load(file)["view"];
+  const YAML::Node section = loadYamlMap(file)["view"];
   if (!section) return;
   apply(file, section, viewKeys(v), "view.");
   // Rates above 100 Hz would only cost CPU: no display or ROS tool draws faster.
