@@ -3,6 +3,7 @@
 // between two stretches, and how precisely the map's own measurements could fix it.
 // hiveslam eval bench DIR/bench.json: a saved bench's table and acceptance rules, again.
 // hiveslam eval remeasure ATLAS DATASET: a saved map on patch-aligned observations (eval_remeasure).
+// hiveslam eval matches DATASET: data association against a render's scene (eval_matches).
 #include <fmt/format.h>
 
 #include <nlohmann/json.hpp>
@@ -12,6 +13,7 @@
 
 #include "apps/bench.hpp"
 #include "apps/commands.hpp"
+#include "apps/eval_matches.hpp"
 #include "apps/eval_remeasure.hpp"
 #include "common/error.hpp"
 #include "eval/scale_precision.hpp"
@@ -23,6 +25,7 @@
 #include "core/features/orb_extractor.hpp"
 #include "core/optim/map_ba_problem.hpp"
 #include "io/atlas_file.hpp"
+#include "io/slam_settings_io.hpp"
 #include "io/trajectory_io.hpp"
 
 namespace hiveslam::apps {
@@ -241,6 +244,22 @@ void addEvalCommand(CLI::App& app) {
       windows.emplace_back(from, to);
     }
     evalRemeasure(pickMap(io::loadAtlas(*remeasure_atlas), *remeasure_map), *remeasure_dataset, *remeasure_split, windows);
+  });
+
+  auto matches_dataset = std::make_shared<std::string>(), matches_config = std::make_shared<std::string>();
+  auto matches_options = std::make_shared<MatchesOptions>();
+  auto* matches_cmd = eval->add_subcommand(
+      "matches", "A rendered sequence run again (sequential) with its scene as the judge of every new point and tracked match");
+  matches_cmd->footer("Example:\n  hiveslam eval matches seq/handheld1 --frames 300 --sharp");
+  matches_cmd->add_option("DATASET", *matches_dataset, "A sequence written by hiveslam synth (its sequence.json)")->required();
+  matches_cmd->add_option("--frames", matches_options->frames, "Only the first N frames")->check(CLI::Range(1, 1000000));
+  matches_cmd->add_flag("--sharp", matches_options->sharp,
+                        "Render without motion blur, rolling shutter, hand tremor and lens error");
+  matches_cmd->add_option("--config", *matches_config, "Settings YAML (its slam section)");
+  matches_cmd->callback([=]() {
+    core::SlamSettings settings;
+    if (!matches_config->empty()) io::applySlamSettings(*matches_config, settings);
+    evalMatches(*matches_dataset, settings, *matches_options);
   });
 
   auto bench_file = std::make_shared<std::string>();

@@ -1,31 +1,17 @@
 // Every sub-command's --help exits 0 and shows an example. The sub-commands are read from the
 // help itself, so a new one is covered without touching this test.
 #include <gtest/gtest.h>
-#include <sys/wait.h>
 
-#include <array>
-#include <cstdio>
 #include <sstream>
 #include <string>
 #include <vector>
 
+#include "apps/hiveslam_output.hpp"
+
 namespace {
 
-struct Output {
-  int status = -1;
-  std::string text;
-};
-
-Output run(const std::string& args) {
-  Output out;
-  FILE* pipe = popen((std::string(HIVESLAM_BINARY) + " " + args + " 2>&1").c_str(), "r");
-  if (!pipe) return out;
-  std::array<char, 256> buf{};
-  while (fgets(buf.data(), buf.size(), pipe)) out.text += buf.data();
-  const int status = pclose(pipe);
-  out.status = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  return out;
-}
+using hiveslam::testing::Output;
+Output run(const std::string& args) { return hiveslam::testing::runHiveslam(args); }
 
 // The names CLI11 lists under "Subcommands:", one per line, each followed by its description.
 std::vector<std::string> subcommands(const std::string& help) {

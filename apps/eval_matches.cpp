@@ -1,0 +1,257 @@
+#include "apps/eval_matches.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <mutex>
+#include <optional>
+
+#include "core/camera/pinhole_radtan.hpp"
+#include "core/map/map.hpp"
+#include "core/map/map_point.hpp"
+#include "core/system/slam_system.hpp"
+#include "synth/sequence.hpp"
+
+namespace hiveslam::apps {
+
+namespace {
+
+// A match joins two different scene points when its keypoint lies further from where the scene
+// point truly appears than this many pixels times the keypoint's pyramid scale (the corner
+// detector places a keypoint to about a pixel of its level).
+constexpr double kWrongPx = 4.0;
+
+// The scene a rendered sequence was made of, asked where a map point truly is and where it truly
+// appears in a frame.
+class SceneOracle {
+ public:
+  explicit SceneOracle(const synth::SequenceModel& model) : model_(model) {
+    for (int f = 0; f < model.options.frames; ++f) frame_at_[model.stamp(f)] = f;
+  }
+
+  std::optional<int> frameOf(double stamp) const {
+    const auto it = frame_at_.find(stamp);
+    if (it == frame_at_.end()) return std::nullopt;
+    return it->second;
+  }
+
+  // The scene point behind a detected (distorted) keypoint of frame f.
+  std::optional<Eigen::Vector3d> scenePoint(const cv::Point2f& pixel, int f) const {
+    const Eigen::Vector2d n = model_.true_lens.pixelToNormalized(pixel.x, pixel.y);
+    const Eigen::Isometry3d T_wc = model_.pose(f);
+    const Eigen::Vector3d dir = (T_wc.linear() * Eigen::Vector3d(n.x(), n.y(), 1)).normalized();
+    const auto hit = model_.scene.intersect(T_wc.translation(), dir);
+    if (!hit) return std::nullopt;
+    return Eigen::Vector3d(T_wc.translation() + hit->t * dir);
+  }
+
+  // Where a map point truly is: the scene point behind its first keyframe's keypoint.
+  std::optional<Eigen::Vector3d> truePoint(const core::MapPoint& p) const {
+    for (const auto& [kf, idx] : p.observations) {
+      if (kf->id != p.first_keyframe) continue;
+      const auto f = frameOf(kf->frame.timestamp);
+      if (!f) return std::nullopt;
+      return scenePoint(kf->frame.keypoints[static_cast<size_t>(idx)].pt, *f);
+    }
+    return std::nullopt;
+  }
+
+  // The (distorted) pixel where a world point appears in frame f.
+  std::optional<Eigen::Vector2d> appears(const Eigen::Vector3d& X, int f) const {
+    const Eigen::Vector3d c = model_.pose(f).inverse() * X;
+    if (c.z() <= 0) return std::nullopt;
+    const synth::Lens& L = model_.true_lens;
+    const Eigen::Vector2d d = L.distort({c.x() / c.z(), c.y() / c.z()});
+    return Eigen::Vector2d(L.fx * d.x() + L.cx, L.fy * d.y() + L.cy);
+  }
+
+  const synth::SequenceModel& model() const { return model_; }
+
+ private:
+  const synth::SequenceModel& model_;
+  std::map<double, int> frame_at_;
+};
+
+double scaleOf(int octave) { return std::pow(1.2, octave); }
+
+class MatchProbe : public core::SystemEvents {
+ public:
+  explicit MatchProbe(const SceneOracle& oracle) : oracle_(oracle) {}
+
+  void mapCreated(const std::shared_ptr<core::Map>& map) override {
+    std::lock_guard l(mutex_);
+    fmt::print("map {} started\n", map->id);
+    origin_.reset();
+  }
+
+  // New points as local mapping made them: does each join one scene point in every view?
+  void keyframeTriangulated(const std::shared_ptr<core::Map>& map, const std::shared_ptr<core::KeyFrame>& kf) override {
+    std::lock_guard l(mutex_);
+    std::lock_guard lock(map->mutex);
+    const auto f = oracle_.frameOf(kf->frame.timestamp);
+    if (!f) return;
+    int made = 0, wrong = 0;
+    for (size_t i = 0; i < kf->points.size(); ++i) {
+      const auto& p = kf->points[i];
+      if (!p || p->bad || p->first_keyframe != kf->id) continue;
+      const auto X = oracle_.truePoint(*p);
+      if (!X) continue;
+      ++made;
+      bool joins_two = false;
+      for (const auto& [other, idx] : p->observations) {
+        const auto g = other == kf.get() ? std::nullopt : oracle_.frameOf(other->frame.timestamp);
+        if (!g) continue;
+        const auto& kp = other->frame.keypoints[static_cast<size_t>(idx)];
+        const auto at = oracle_.appears(*X, *g);
+        const int octave = std::max(kp.octave, kf->frame.keypoints[i].octave);
+        joins_two |= !at || (*at - Eigen::Vector2d(kp.pt.x, kp.pt.y)).norm() > kWrongPx * scaleOf(octave);
+      }
+      wrong += joins_two;
+    }
+    new_points_ += made;
+    new_wrong_ += wrong;
+    pending_[kf->id] = {made, wrong};
+  }
+
+  // The keyframe after local BA: its rotation error and the map's scale around it.
+  void keyframeMapped(const std::shared_ptr<core::Map>& map, const std::shared_ptr<core::KeyFrame>& kf) override {
+    std::lock_guard l(mutex_);
+    std::lock_guard lock(map->mutex);
+    const auto f = oracle_.frameOf(kf->frame.timestamp);
+    if (!f) return;
+    if (!origin_ && map->origin) {
+      const auto g = oracle_.frameOf(map->origin->frame.timestamp);
+      if (g) origin_ = Origin{map->origin->T_cw, oracle_.model().pose(*g)};
+    }
+    // The map's scale: the median over the keyframe's points of true over estimated distance.
+    std::vector<double> ratios;
+    const Eigen::Vector3d center = kf->center(), true_center = oracle_.model().pose(*f).translation();
+    for (size_t i = 0; i < kf->points.size(); ++i) {
+      const auto& p = kf->points[i];
+      if (!p || p->bad) continue;
+      const auto X = oracle_.scenePoint(kf->frame.keypoints[i].pt, *f);
+      const double est = (p->position - center).norm();
+      if (X && est > 0) ratios.push_back((*X - true_center).norm() / est);
+    }
+    double scale = 0;
+    if (!ratios.empty()) {
+      std::nth_element(ratios.begin(), ratios.begin() + static_cast<long>(ratios.size() / 2), ratios.end());
+      scale = ratios[ratios.size() / 2];
+    }
+    const auto made = pending_[kf->id];
+    pending_.erase(kf->id);
+    fmt::print("keyframe {:6} at {:7.2f} s: {:4} new points, {:5.1f}% joining two scene points | rotation error {:6.2f} deg | {:7.3f} m per map unit\n",
+               kf->id, oracle_.model().stamp(*f) - oracle_.model().stamp(0), made.first,
+               made.first ? 100.0 * made.second / made.first : 0.0, rotationError(kf->T_cw, *f), scale);
+  }
+
+  // A tracked frame's inliers: is each keypoint where its map point's scene point appears?
+  void frame(const core::FrameRecord& r, const Eigen::Isometry3d& T_cw, const std::shared_ptr<core::Map>& map) {
+    const auto f = oracle_.frameOf(r.timestamp);
+    if (!f) return;
+    std::lock_guard l(mutex_);
+    Second& s = seconds_[static_cast<int>(oracle_.model().stamp(*f) - oracle_.model().stamp(0))];
+    ++s.frames;
+    if (!r.tracked || !map) return;
+    ++s.tracked;
+    std::lock_guard lock(map->mutex);
+    for (const auto& o : r.observations) {
+      const auto it = map->points.find(o.point);
+      if (it == map->points.end()) continue;
+      const auto X = oracle_.truePoint(*it->second);
+      if (!X) continue;
+      const auto at = oracle_.appears(*X, *f);
+      Eigen::Vector2d raw;
+      const Eigen::Vector3d ray((o.uv.x() - K_.cx) / K_.fx, (o.uv.y() - K_.cy) / K_.fy, 1.0);
+      if (!camera_ || !camera_->project(ray, raw)) continue;
+      ++s.matches;
+      s.wrong += !at || (*at - raw).norm() > kWrongPx * scaleOf(o.octave);
+    }
+    s.rotation_error = std::max(s.rotation_error, rotationError(T_cw, *f));
+  }
+
+  void setCamera(std::shared_ptr<const camera::CameraModel> camera, const core::Intrinsics& K) {
+    camera_ = std::move(camera);
+    K_ = K;
+  }
+
+  void summary() {
+    std::lock_guard l(mutex_);
+    fmt::print("\nsecond | frames tracked | tracking inliers joined to another scene point | largest rotation error, deg\n");
+    int64_t matches = 0, wrong = 0;
+    for (const auto& [second, s] : seconds_) {
+      fmt::print("{:6} | {:3} of {:3} | {:5.1f}% of {:5} | {:6.2f}\n", second, s.tracked, s.frames,
+                 s.matches ? 100.0 * static_cast<double>(s.wrong) / static_cast<double>(s.matches) : 0.0, s.matches,
+                 s.rotation_error);
+      matches += s.matches;
+      wrong += s.wrong;
+    }
+    fmt::print("\nnew points: {}, {:.1f}% joining two scene points; tracking inliers: {}, {:.1f}% joined to another scene point\n",
+               new_points_, new_points_ ? 100.0 * new_wrong_ / new_points_ : 0.0, matches,
+               matches ? 100.0 * static_cast<double>(wrong) / static_cast<double>(matches) : 0.0);
+  }
+
+ private:
+  struct Origin {
+    Eigen::Isometry3d T_cw, T_wc_true;
+  };
+  struct Second {
+    int frames = 0, tracked = 0;
+    int64_t matches = 0, wrong = 0;
+    double rotation_error = 0;
+  };
+
+  // Rotation since the map's first keyframe, estimated against true, in degrees.
+  double rotationError(const Eigen::Isometry3d& T_cw, int f) const {
+    if (!origin_) return 0;
+    const Eigen::Matrix3d est = origin_->T_cw.linear() * T_cw.linear().transpose();
+    const Eigen::Matrix3d truth = origin_->T_wc_true.linear().transpose() * oracle_.model().pose(f).linear();
+    return Eigen::AngleAxisd(est.transpose() * truth).angle() * 180.0 / M_PI;
+  }
+
+  const SceneOracle& oracle_;
+  std::mutex mutex_;
+  std::optional<Origin> origin_;
+  std::map<core::Id, std::pair<int, int>> pending_;
+  std::map<int, Second> seconds_;
+  int new_points_ = 0, new_wrong_ = 0;
+  std::shared_ptr<const camera::CameraModel> camera_;
+  core::Intrinsics K_;
+};
+
+}  // namespace
+
+void evalMatches(const std::string& dataset, const core::SlamSettings& settings, const MatchesOptions& options) {
+  synth::SequenceOptions o = synth::readSequenceOptions(dataset);
+  if (options.sharp) {
+    o.motion_blur = false;
+    o.exposure_ms = 0;
+    o.readout_ms = 0;
+    o.tremor_deg = 0;
+    o.lens_error = false;
+  }
+  const auto model = synth::buildSequence(o);
+  const synth::RayTable rays(model.true_lens);
+  const synth::Lens& L = model.lens;
+  auto camera = std::make_shared<camera::PinholeRadTan>(L.width, L.height, L.fx, L.fy, L.cx, L.cy,
+                                                        std::vector<double>(L.k.begin(), L.k.end()));
+  SceneOracle oracle(model);
+  MatchProbe probe(oracle);
+  core::SlamSettings s = settings;
+  s.refine_frames = true;  // the frames' inliers
+  core::SlamSystem slam(s, camera, core::SlamSystem::Mode::Sequential);
+  // Inliers come as undistorted pixels of the camera's pinhole part: back to raw pixels.
+  probe.setCamera(camera, {L.fx, L.fy, L.cx, L.cy});
+  slam.setEvents(&probe);
+  slam.setFrameListener([&](const core::FrameRecord& r, const Eigen::Isometry3d& T_cw, const std::vector<cv::KeyPoint>&,
+                            const cv::Mat&) { probe.frame(r, T_cw, slam.findMap(r.map)); });
+  const int frames = options.frames > 0 ? std::min(options.frames, o.frames) : o.frames;
+  fmt::print("{}: {} frames{}, sequential\n", dataset, frames, options.sharp ? ", sharp (no blur, rolling shutter, tremor or lens error)" : "");
+  for (int f = 0; f < frames; ++f) slam.process(model.renderImage(f, rays), model.stamp(f));
+  slam.finish();
+  probe.summary();
+}
+
+}  // namespace hiveslam::apps
