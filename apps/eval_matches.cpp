@@ -172,6 +172,29 @@ class MatchProbe : public core::SystemEvents {
     s.rotation_error = std::max(s.rotation_error, rotationError(T_cw, *f));
   }
 
+  // The map as the run left it: its points with an observation away from their scene point.
+  void judgeMap(const core::Map& map) {
+    std::lock_guard l(mutex_);
+    int points = 0, wrong = 0;
+    for (const auto& [id, p] : map.points) {
+      if (p->bad) continue;
+      const auto X = oracle_.truePoint(*p);
+      if (!X) continue;
+      ++points;
+      bool joins_two = false;
+      for (const auto& [kf, idx] : p->observations) {
+        const auto g = oracle_.frameOf(kf->frame.timestamp);
+        if (!g) continue;
+        const auto& kp = kf->frame.keypoints[static_cast<size_t>(idx)];
+        const auto at = oracle_.appears(*X, *g);
+        joins_two |= !at || (*at - Eigen::Vector2d(kp.pt.x, kp.pt.y)).norm() > kWrongPx * scaleOf(kp.octave);
+      }
+      wrong += joins_two;
+    }
+    fmt::print("map {} at the end: {} points, {:.1f}% with an observation of another scene point\n", map.id, points,
+               points ? 100.0 * wrong / points : 0.0);
+  }
+
   void setCamera(std::shared_ptr<const camera::CameraModel> camera, const core::Intrinsics& K) {
     camera_ = std::move(camera);
     K_ = K;
@@ -252,6 +275,10 @@ void evalMatches(const std::string& dataset, const core::SlamSettings& settings,
   for (int f = 0; f < frames; ++f) slam.process(model.renderImage(f, rays), model.stamp(f));
   slam.finish();
   probe.summary();
+  if (const auto map = slam.largestMap()) {
+    std::lock_guard lock(map->mutex);
+    probe.judgeMap(*map);
+  }
 }
 
 }  // namespace hiveslam::apps
