@@ -135,16 +135,24 @@ class MatchProbe : public core::SystemEvents {
       const double est = (p->position - center).norm();
       if (X && est > 0) ratios.push_back((*X - true_center).norm() / est);
     }
-    double scale = 0;
+    double scale = 0, misplaced = 0;
     if (!ratios.empty()) {
-      std::nth_element(ratios.begin(), ratios.begin() + static_cast<long>(ratios.size() / 2), ratios.end());
-      scale = ratios[ratios.size() / 2];
+      std::vector<double> sorted = ratios;
+      std::nth_element(sorted.begin(), sorted.begin() + static_cast<long>(sorted.size() / 2), sorted.end());
+      scale = sorted[sorted.size() / 2];
+      // Misplaced: at a distance from the keyframe more than 25% off what the map's scale there
+      // makes of the true one, whether its partner was right or not.
+      for (double r : ratios) misplaced += std::abs(r / scale - 1) > 0.25;
+      misplaced /= static_cast<double>(ratios.size());
     }
     const auto made = pending_[kf->id];
     pending_.erase(kf->id);
-    fmt::print("keyframe {:6} at {:7.2f} s: {:4} new points, {:5.1f}% joining two scene points | rotation error {:6.2f} deg | {:7.3f} m per map unit\n",
+    fmt::print("keyframe {:6} at {:7.2f} s: {:4} new points, {:5.1f}% joining two scene points | {:5.1f}% of its {:4} points misplaced | rotation error {:6.2f} deg | {:7.3f} m per map unit\n",
                kf->id, oracle_.model().stamp(*f) - oracle_.model().stamp(0), made.first,
-               made.first ? 100.0 * made.second / made.first : 0.0, rotationError(kf->T_cw, *f), scale);
+               made.first ? 100.0 * made.second / made.first : 0.0, 100.0 * misplaced, ratios.size(),
+               rotationError(kf->T_cw, *f), scale);
+    misplaced_sum_ += misplaced;
+    ++keyframes_;
   }
 
   // A tracked frame's inliers: is each keypoint where its map point's scene point appears?
@@ -214,6 +222,8 @@ class MatchProbe : public core::SystemEvents {
     fmt::print("\nnew points: {}, {:.1f}% joining two scene points; tracking inliers: {}, {:.1f}% joined to another scene point\n",
                new_points_, new_points_ ? 100.0 * new_wrong_ / new_points_ : 0.0, matches,
                matches ? 100.0 * static_cast<double>(wrong) / static_cast<double>(matches) : 0.0);
+    fmt::print("keyframes after local BA: {}, on average {:.1f}% of their points misplaced (25% off the map's scale)\n",
+               keyframes_, keyframes_ ? 100.0 * misplaced_sum_ / keyframes_ : 0.0);
   }
 
  private:
@@ -239,7 +249,8 @@ class MatchProbe : public core::SystemEvents {
   std::optional<Origin> origin_;
   std::map<core::Id, std::pair<int, int>> pending_;
   std::map<int, Second> seconds_;
-  int new_points_ = 0, new_wrong_ = 0;
+  int new_points_ = 0, new_wrong_ = 0, keyframes_ = 0;
+  double misplaced_sum_ = 0;
   std::shared_ptr<const camera::CameraModel> camera_;
   core::Intrinsics K_;
 };

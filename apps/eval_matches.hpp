@@ -16,7 +16,8 @@ struct MatchesOptions {
 // sequence.json, rendered again) and prints, per keyframe, how many of the points local mapping
 // made join two different scene points, and per second how many of tracking's inliers are
 // matched to another scene point than their map point's, the rotation error since the map's
-// first keyframe and the map's scale (true metres per map unit) at each keyframe.
+// first keyframe, the share of each keyframe's points at the wrong distance and the map's scale
+// (true metres per map unit) at each keyframe, and at the end the largest map's wrong points.
 void evalMatches(const std::string& dataset, const core::SlamSettings& settings, const MatchesOptions& options);
 
 }  // namespace hiveslam::apps
