@@ -219,12 +219,6 @@ void DistributedNode::onPeer(const PeerInfo& peer, bool present) {
   // A node that joins late gets the maps so far from the gateway; a mapping node that joins
   // (or returns) gets them from the node that mapped until now, which gives mapping up to it.
   const Plan after = plan();
-  if (newcomer && before.mapping && !after.mapping) {
-    // A gateway taking the map over answers nothing until it holds it (handover_wait_ms at
-    // most): it is not judged slow before its first answer (a restarted LM was released).
-    std::lock_guard lock(mutex_);
-    handover_pending_ = true;
-  }
   // A tracking node back from a partition (the same incarnation) kept its maps and mapped on
   // alone meanwhile: its maps are newer than this node's and come here with mapping. This
   // node's older snapshot, sent to it, would overwrite them (a 30 s cut of TR from LM and LC
@@ -330,6 +324,11 @@ void DistributedNode::applyPlan() {
     subscribed_ = p.subscriptions;
     if (!changed && add.empty() && remove.empty()) return;
     lost_waiting_ = false;  // a loss under the old plan says nothing of a new gateway
+    if (p.mapping != before.mapping) watch_.restart();
+    // A gateway taking the map over answers nothing until it holds it (handover_wait_ms at
+    // most): it is not judged slow before its first answer (a restarted LM was released). Set
+    // with the plan: set after it, tracking judged the new gateway in between.
+    if (before.mapping && !p.mapping) handover_pending_ = true;
     if (p.mapping && !before.mapping) {
       orphans.swap(outstanding_);
       orphans.insert(unanswered_.begin(), unanswered_.end());

@@ -32,6 +32,12 @@ class GatewayWatch {
     waiting_since_.reset();
     slow_in_a_row_ = round_trip > slow_ ? slow_in_a_row_ + 1 : 0;
   }
+  // Another gateway, or none: the next one is judged on its own answers. A keyframe sent to a
+  // gateway that died, left waiting, had a restarted LM released as slow the moment it joined.
+  void restart() {
+    waiting_since_.reset();
+    slow_in_a_row_ = 0;
+  }
   bool tooSlow(Clock::time_point now) const {
     if (!on()) return false;
     return slow_in_a_row_ >= slow_acks_ ||
