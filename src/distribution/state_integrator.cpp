@@ -421,9 +421,6 @@ bool StateIntegrator::applyGlobal(const std::vector<MapRecord>& batches, bool au
     std::lock_guard lock(m->mutex);
     if (left(*m)) return false;
   }
-  if (authoritative)
-    for (const auto& b : batches) observer_.revive(b);
-  for (const auto& b : batches) observer_.record(b);
   // Keyframes sent with their features (a snapshot for a node that joined) that this node
   // does not hold yet are made here; bags of words before the lock. Such a snapshot may bring
   // a map this node has never seen. Every node reading the map topic gets the newcomer's
@@ -459,14 +456,20 @@ bool StateIntegrator::applyGlobal(const std::vector<MapRecord>& batches, bool au
   std::unique_lock lock(map->mutex);
   if (left(*map)) {
     // It left that frame since the check above: what is new is taken, as from a stale local
-    // map, and the caller goes on as for an ignored update. (S_full recorded the batches'
-    // poses already; the next update corrects them.)
+    // map, and the caller goes on as for an ignored update.
     for (const auto& b : batches) {
       takeNewPoints(*map, b);
       applyErasures(*map, b);
     }
     return false;
   }
+  // S_full takes the update only now that the map does: recorded before the check above, an
+  // update then ignored brought back into S_full keyframes this node had culled since (a stale
+  // global map of LC's, at TR after a 30 s partition: TR's S_full listed two keyframes its map
+  // no longer had).
+  if (authoritative)
+    for (const auto& b : batches) observer_.revive(b);
+  for (const auto& b : batches) observer_.record(b);
   // One correction: covered keyframes go to their new poses, the others follow their ancestors.
   core::PoseCorrection c;
   std::vector<Id> kf_ids, point_ids;
