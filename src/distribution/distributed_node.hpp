@@ -33,6 +33,7 @@
 #include <set>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <nlohmann/json.hpp>
 #include <thread>
 #include <vector>
@@ -183,6 +184,9 @@ class DistributedNode final : public core::SystemEvents {
   bool had_mapping_peer_ = false;  // a mapping node was among the peers at some point
   bool stopping_ = false;  // stop() has begun: no finisher may start any more
   uint8_t run_hosted_ = 0;  // what it ran when the sequence ended (before peers leave)
+  // Its peers when its input ended: those that leave at the end of a run (LM and LC once the
+  // last map is in) may go before the report is written (a 3-node run reported 1 peer of 2).
+  std::optional<size_t> peers_at_end_;
   int globals_ignored_ = 0;
   int local_maps_held_ = 0;  // local maps that came ahead of their global update
   uint64_t incarnation_ = 0;

@@ -139,6 +139,7 @@ bool DistributedNode::finishRun(std::chrono::milliseconds timeout) {
   {
     std::lock_guard lock(mutex_);
     run_hosted_ = p.hosted;
+    peers_at_end_ = peers_.size();
   }
   if (p.keyframes_to_lm) {
     pushRemeasurements(slam_.remeasureOwnKeyframes(), Topic::TrKeyframes);

@@ -60,7 +60,7 @@ nlohmann::json DistributedNode::report(double seconds) const {
     if (!ack_ms_.empty()) j["keyframe_ack_ms"] = ackSummary(ack_ms_);
     if (!released_names_.empty()) j["peers_released"] = released_names_;
     j["stale_points_carried"] = integrator_.stalePointsCarried();
-    j["peers"] = peers_.size();
+    j["peers"] = peers_at_end_.value_or(peers_.size());
   }
   j["s_full_keyframes"] = observer_.keyframeCount();
   j["s_full_keyframes_not_in_map"] = sFullKeyframesNotInMap();

@@ -144,7 +144,7 @@ TEST(LiveViewProcesses, AClusterPublishesTheRosTypesAndAViewJoinsWithoutATask) {
              lc = report(out / "lc" / "report.json");
   ASSERT_TRUE(tr.contains("tracked_frames")) << slurp(out / "tr.log");
   // The view was no one's peer and moved no task.
-  EXPECT_EQ(tr.value("peers", -1), 2);
+  EXPECT_EQ(tr.value("peers", -1), 2) << slurp(out / "tr.log") << slurp(out / "lm.log") << slurp(out / "lc.log");
   EXPECT_EQ(tr["tasks"], nlohmann::json({"tr"}));
   EXPECT_EQ(lm["tasks"], nlohmann::json({"lm"}));
   EXPECT_EQ(lc["tasks"], nlohmann::json({"lc"}));
