@@ -78,7 +78,7 @@ double scaleOf(int octave) { return std::pow(1.2, octave); }
 
 class MatchProbe : public core::SystemEvents {
  public:
-  explicit MatchProbe(const SceneOracle& oracle) : oracle_(oracle) {}
+  MatchProbe(const SceneOracle& oracle, float fast_threshold) : oracle_(oracle), fast_threshold_(fast_threshold) {}
 
   void mapCreated(const std::shared_ptr<core::Map>& map) override {
     std::lock_guard l(mutex_);
@@ -109,6 +109,13 @@ class MatchProbe : public core::SystemEvents {
         joins_two |= !at || (*at - Eigen::Vector2d(kp.pt.x, kp.pt.y)).norm() > kWrongPx * scaleOf(octave);
       }
       wrong += joins_two;
+      // Found only at the detector's lower threshold (a corner weaker than fast_threshold): on
+      // plain walls these are the image noise's.
+      const bool weak = std::any_of(p->observations.begin(), p->observations.end(), [&](const auto& o) {
+        return o.first->frame.keypoints[static_cast<size_t>(o.second)].response < fast_threshold_;
+      });
+      weak_points_ += weak;
+      weak_wrong_ += weak && joins_two;
     }
     new_points_ += made;
     new_wrong_ += wrong;
@@ -222,6 +229,10 @@ class MatchProbe : public core::SystemEvents {
     fmt::print("\nnew points: {}, {:.1f}% joining two scene points; tracking inliers: {}, {:.1f}% joined to another scene point\n",
                new_points_, new_points_ ? 100.0 * new_wrong_ / new_points_ : 0.0, matches,
                matches ? 100.0 * static_cast<double>(wrong) / static_cast<double>(matches) : 0.0);
+    fmt::print("new points with a keypoint found only at the detector's lower threshold: {} ({:.1f}%), {:.1f}% of them joining two scene points; the others {:.1f}%\n",
+               weak_points_, new_points_ ? 100.0 * weak_points_ / new_points_ : 0.0,
+               weak_points_ ? 100.0 * weak_wrong_ / weak_points_ : 0.0,
+               new_points_ > weak_points_ ? 100.0 * (new_wrong_ - weak_wrong_) / (new_points_ - weak_points_) : 0.0);
     fmt::print("keyframes after local BA: {}, on average {:.1f}% of their points misplaced (25% off the map's scale)\n",
                keyframes_, keyframes_ ? 100.0 * misplaced_sum_ / keyframes_ : 0.0);
   }
@@ -249,7 +260,8 @@ class MatchProbe : public core::SystemEvents {
   std::optional<Origin> origin_;
   std::map<core::Id, std::pair<int, int>> pending_;
   std::map<int, Second> seconds_;
-  int new_points_ = 0, new_wrong_ = 0, keyframes_ = 0;
+  int new_points_ = 0, new_wrong_ = 0, keyframes_ = 0, weak_points_ = 0, weak_wrong_ = 0;
+  float fast_threshold_ = 0;
   double misplaced_sum_ = 0;
   std::shared_ptr<const camera::CameraModel> camera_;
   core::Intrinsics K_;
@@ -272,7 +284,7 @@ void evalMatches(const std::string& dataset, const core::SlamSettings& settings,
   auto camera = std::make_shared<camera::PinholeRadTan>(L.width, L.height, L.fx, L.fy, L.cx, L.cy,
                                                         std::vector<double>(L.k.begin(), L.k.end()));
   SceneOracle oracle(model);
-  MatchProbe probe(oracle);
+  MatchProbe probe(oracle, static_cast<float>(settings.orb.fast_threshold));
   core::SlamSettings s = settings;
   s.refine_frames = true;  // the frames' inliers
   core::SlamSystem slam(s, camera, core::SlamSystem::Mode::Sequential);
