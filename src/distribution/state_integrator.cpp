@@ -347,16 +347,22 @@ void StateIntegrator::takeNewPoints(core::Map& map, const MapRecord& m) {
     if (applyPoint(map, p)) observer_.record(p, m.map);
 }
 
+void StateIntegrator::takeStale(core::Map& map, const MapRecord& m) {
+  takeNewPoints(map, m);
+  applyErasures(map, m);
+  // S_full loses what the map lost: an erasure in the map alone left S_full listing a keyframe
+  // the map no longer had.
+  for (Id id : m.erased_keyframes) observer_.eraseKeyframe(id);
+  for (Id id : m.erased_points) observer_.erasePoint(id);
+  for (const auto& [old, by] : m.replaced_points) observer_.erasePoint(old);
+}
+
 void StateIntegrator::applyLocal(const MapRecord& m) {
   auto map = slam_.findMap(m.map);
   if (!map || map->merged_into.load()) return;
   std::lock_guard lock(map->mutex);
   if (stale(*map, m.epoch)) {
-    takeNewPoints(*map, m);
-    applyErasures(*map, m);
-    for (Id id : m.erased_keyframes) observer_.eraseKeyframe(id);
-    for (Id id : m.erased_points) observer_.erasePoint(id);
-    for (const auto& [old, by] : m.replaced_points) observer_.erasePoint(old);
+    takeStale(*map, m);
     return;
   }
   observer_.record(m);
@@ -457,10 +463,7 @@ bool StateIntegrator::applyGlobal(const std::vector<MapRecord>& batches, bool au
   if (left(*map)) {
     // It left that frame since the check above: what is new is taken, as from a stale local
     // map, and the caller goes on as for an ignored update.
-    for (const auto& b : batches) {
-      takeNewPoints(*map, b);
-      applyErasures(*map, b);
-    }
+    for (const auto& b : batches) takeStale(*map, b);
     return false;
   }
   // S_full takes the update only now that the map does: recorded before the check above, an

@@ -93,6 +93,9 @@ class StateIntegrator {
   // True when the keyframe's point links changed.
   bool relink(core::Map& map, core::KeyFrame& kf, const KeyFrameRecord& r);
   void applyErasures(core::Map& map, const MapRecord& m);
+  // What a stale record (made in a frame this map has left) can still bring: its new points and
+  // its erasures, in the map and in S_full alike.
+  void takeStale(core::Map& map, const MapRecord& m);
   // A record's new points, from another frame, carried into the map's. With its mutex held.
   void takeNewPoints(core::Map& map, const MapRecord& m);
   // The new points of a local map in another frame (stale or ahead), moved into the map's
