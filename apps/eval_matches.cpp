@@ -99,15 +99,7 @@ class MatchProbe : public core::SystemEvents {
       const auto X = oracle_.truePoint(*p);
       if (!X) continue;
       ++made;
-      bool joins_two = false;
-      for (const auto& [other, idx] : p->observations) {
-        const auto g = other == kf.get() ? std::nullopt : oracle_.frameOf(other->frame.timestamp);
-        if (!g) continue;
-        const auto& kp = other->frame.keypoints[static_cast<size_t>(idx)];
-        const auto at = oracle_.appears(*X, *g);
-        const int octave = std::max(kp.octave, kf->frame.keypoints[i].octave);
-        joins_two |= !at || (*at - Eigen::Vector2d(kp.pt.x, kp.pt.y)).norm() > kWrongPx * scaleOf(octave);
-      }
+      const bool joins_two = seesAnotherPoint(*p, *X, kf->frame.keypoints[i].octave);
       wrong += joins_two;
       // Found only at the detector's lower threshold (a corner weaker than fast_threshold): on
       // plain walls these are the image noise's.
@@ -196,15 +188,7 @@ class MatchProbe : public core::SystemEvents {
       const auto X = oracle_.truePoint(*p);
       if (!X) continue;
       ++points;
-      bool joins_two = false;
-      for (const auto& [kf, idx] : p->observations) {
-        const auto g = oracle_.frameOf(kf->frame.timestamp);
-        if (!g) continue;
-        const auto& kp = kf->frame.keypoints[static_cast<size_t>(idx)];
-        const auto at = oracle_.appears(*X, *g);
-        joins_two |= !at || (*at - Eigen::Vector2d(kp.pt.x, kp.pt.y)).norm() > kWrongPx * scaleOf(kp.octave);
-      }
-      wrong += joins_two;
+      wrong += seesAnotherPoint(*p, *X, 0);
     }
     fmt::print("map {} at the end: {} points, {:.1f}% with an observation of another scene point\n", map.id, points,
                points ? 100.0 * wrong / points : 0.0);
@@ -246,6 +230,20 @@ class MatchProbe : public core::SystemEvents {
     int64_t matches = 0, wrong = 0;
     double rotation_error = 0;
   };
+
+  // Whether a keyframe sees the map point whose scene point is X away from where X appears: its
+  // keypoint further than kWrongPx times its level's scale (at least `min_octave`'s).
+  bool seesAnotherPoint(const core::MapPoint& p, const Eigen::Vector3d& X, int min_octave) const {
+    for (const auto& [kf, idx] : p.observations) {
+      const auto g = oracle_.frameOf(kf->frame.timestamp);
+      if (!g) continue;
+      const auto& kp = kf->frame.keypoints[static_cast<size_t>(idx)];
+      const auto at = oracle_.appears(X, *g);
+      if (!at || (*at - Eigen::Vector2d(kp.pt.x, kp.pt.y)).norm() > kWrongPx * scaleOf(std::max(kp.octave, min_octave)))
+        return true;
+    }
+    return false;
+  }
 
   // Rotation since the map's first keyframe, estimated against true, in degrees.
   double rotationError(const Eigen::Isometry3d& T_cw, int f) const {
