@@ -20,6 +20,7 @@ struct ClusterOptions {
   // so TR gets raw pixels as from a camera driver (and decodes no image files). The
   // calibration is the dataset's sensor.yaml, or --config.
   bool feed_topic = false;
+  std::string secure;  // DDS Security: the keys folder (hiveslam keys); empty: off
 };
 
 struct ClusterResult {

@@ -74,6 +74,7 @@ ClusterResult runCluster(const ClusterOptions& o) {
   std::vector<std::string> common;
   if (!o.config.empty()) common.insert(common.end(), {"--config", o.config});
   if (o.no_loop_closing) common.push_back("--no-loop-closing");
+  if (!o.secure.empty()) common.insert(common.end(), {"--secure", o.secure});  // each node: DIR/<its task>
   std::vector<std::pair<std::string, pid_t>> services;
   const std::vector<std::string> tasks = o.nodes == 3 ? std::vector<std::string>{"lm", "lc"}
                                          : o.nodes == 2 ? std::vector<std::string>{"lm"}
@@ -115,9 +116,12 @@ ClusterResult runCluster(const ClusterOptions& o) {
   if (o.save_atlases) tr.insert(tr.end(), {"--atlas-out", (out / "tr" / "atlas.bin").string()});
   const pid_t tr_pid = spawn(tr);
   pid_t player = 0;
-  if (o.feed_topic)  // the player waits for TR's reader, which TR makes once its peers are there
-    player = spawn({"hiveslam", "play", o.dataset, "--topic", topic, "--domain", std::to_string(domain), "--wait",
-                    "60"});
+  if (o.feed_topic) {  // the player waits for TR's reader, which TR makes once its peers are there
+    std::vector<std::string> args{"hiveslam", "play", o.dataset, "--topic", topic, "--domain", std::to_string(domain),
+                                  "--wait", "60"};
+    if (!o.secure.empty()) args.insert(args.end(), {"--secure", o.secure});
+    player = spawn(args);
+  }
   const int tr_status = reap(tr_pid, o.timeout_seconds);
   if (player && reap(player, 5) != 0) fmt::print(stderr, "cluster: the player did not end cleanly\n");
   // After TR's end-of-run exchange the others finish on their own; a stuck one is stopped.
@@ -147,6 +151,7 @@ void addClusterCommand(CLI::App& app) {
   cmd->add_flag("--no-loop-closing", o->no_loop_closing, "Switch loop closing off");
   cmd->add_flag("--atlases", o->save_atlases, "Each node saves its maps to DIR/<task>/atlas.bin (hiveslam run --atlas-in reads them)");
   cmd->add_flag("--feed-topic", o->feed_topic, "Play the dataset as a ROS 2 image topic to TR (the paper's set-up)");
+  cmd->add_option("--secure", o->secure, "DDS Security: the keys folder `hiveslam keys` made (each node uses DIR/tr, DIR/lm, DIR/lc)");
   cmd->callback([o]() {
     const auto r = runCluster(*o);
     for (const auto& [task, j] : r.reports) {

@@ -17,5 +17,6 @@ void addBenchCommand(CLI::App& app);
 void addPlayCommand(CLI::App& app);
 void addViewCommand(CLI::App& app);
 void addTopicsCommand(CLI::App& app);
+void addKeysCommand(CLI::App& app);
 
 }  // namespace hiveslam::apps

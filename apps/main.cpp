@@ -41,6 +41,7 @@ int main(int argc, char** argv) {
   hiveslam::apps::addPlayCommand(app);
   hiveslam::apps::addViewCommand(app);
   hiveslam::apps::addTopicsCommand(app);
+  hiveslam::apps::addKeysCommand(app);
   int status = 0;
   try {
     app.parse(argc, argv);

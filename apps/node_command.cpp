@@ -12,6 +12,7 @@
 
 #include "apps/commands.hpp"
 #include "apps/run_slam.hpp"
+#include "apps/secure_option.hpp"
 #include "common/error.hpp"
 #include "communication/dds/dds_transport.hpp"
 #include "core/system/slam_system.hpp"
@@ -35,6 +36,7 @@ struct NodeCommandOptions {
   int wait_seconds = 20;
   bool no_ros = false;
   LiveViewOptions live;
+  SecureOption secure;
 };
 
 uint16_t defaultId(communication::Task t) { return static_cast<uint16_t>(static_cast<int>(t) + 1); }
@@ -74,6 +76,7 @@ void serve(const NodeCommandOptions& o, communication::Task task) {
   if (live) live->finish();
   nlohmann::json report = node.report(monitor.wallSeconds());
   report["thread_cpu_seconds"] = eval::ResourceMonitor::threadCpuSeconds();  // before threads end
+  addSecurityReport(report);
   node.stop();
   slam.finish();
   const auto& ms = slam.mappingStats();
@@ -140,11 +143,13 @@ void addNodeCommand(CLI::App& app) {
   addViewerOptions(cmd, o->live);
   cmd->add_flag("--no-ros", o->no_ros, "Do not publish the ROS 2 visualization topics (/hiveslam/<name>/...)");
   cmd->add_option("--atlas-out", o->atlas_out, "Save the node's maps to an atlas file after the run (the same on every node after the end-of-run exchange)");
+  addSecureOption(cmd, o->secure);
   cmd->callback([o]() {
     communication::Task task;
     if (!communication::parseTask(o->task, task)) throw InputError("unknown task '" + o->task + "' (tr, lm or lc)");
     if (o->domain < 0 || o->domain > 232) throw InputError("DDS domain must be 0-232");
     if (o->id < 0 || o->id > 65535) throw InputError("node id must be 1-65535");
+    useSecureOption(o->secure, o->name.empty() ? communication::taskName(task) : o->name);
     if (task != communication::Task::Tracking) {
       if (!o->dataset.empty() || !o->topic.empty()) throw InputError("only a tr node reads images");
       serve(*o, task);

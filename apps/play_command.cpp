@@ -9,6 +9,7 @@
 #include <thread>
 
 #include "apps/commands.hpp"
+#include "apps/secure_option.hpp"
 #include "common/error.hpp"
 #include "communication/dds/image_topic.hpp"
 #include "io/open_dataset.hpp"
@@ -21,6 +22,7 @@ struct PlayOptions {
   std::string dataset, topic = "/camera/image_raw", frame_id = "camera", config, times;
   int domain = 0;
   double rate = 1.0, wait_seconds = 10.0;
+  SecureOption secure;
 };
 
 void play(const PlayOptions& o) {
@@ -29,6 +31,7 @@ void play(const PlayOptions& o) {
   if (!o.config.empty()) dataset_options.settings = o.config;
   if (!o.times.empty()) dataset_options.times = o.times;
   auto source = io::openDataset(o.dataset, dataset_options);
+  useSecureOption(o.secure, "play");
   communication::ImageTopicWriter writer(o.domain, o.topic);
   fmt::print(stderr, "{} -> {} on DDS domain {}\n", source->describe(), communication::ddsTopicName(o.topic), o.domain);
   if (o.wait_seconds > 0 &&
@@ -73,6 +76,7 @@ void addPlayCommand(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--frame-id", o->frame_id, "header.frame_id")->capture_default_str();
   cmd->add_option("--config", o->config, "Settings YAML (camera section)");
+  addSecureOption(cmd, o->secure);
   cmd->add_option("--times", o->times, "Times file for image folders and videos");
   cmd->callback([o]() { play(*o); });
 }

@@ -17,6 +17,7 @@
 #include "apps/topic_frame_source.hpp"
 #include "common/error.hpp"
 #include "communication/dds/dds_transport.hpp"
+#include "communication/dds/participant_security.hpp"
 #include "distribution/distributed_node.hpp"
 #include "core/system/slam_system.hpp"
 #include "eval/error_plots.hpp"
@@ -30,6 +31,11 @@
 #include "io/trajectory_io.hpp"
 
 namespace hiveslam::apps {
+
+void addSecurityReport(nlohmann::json& report) {
+  report["secure"] = communication::secure();
+  report["failed_handshakes"] = communication::failedHandshakes();
+}
 
 nlohmann::json mappingStatsJson(const core::MappingStats& ms) {
   const core::MappingStageMs& t = ms.ms;
@@ -232,6 +238,7 @@ RunSummary runSlam(const RunOptions& o) {
       fmt::print(stderr, "warning: the end-of-run exchange did not complete; the maps may differ between nodes\n");
     node_report = node->report(monitor.wallSeconds());
     node_report["end_of_run"] = completed ? "completed" : "incomplete";
+    addSecurityReport(node_report);
   } else {
     slam.drain();  // the end of the run: the last keyframes mapped, the final global BA
   }
@@ -367,10 +374,14 @@ void addRunCommand(CLI::App& app) {
   cmd->add_flag("--localization", o->localization, "Track against --atlas-in without mapping");
   cmd->add_flag("--verbose", o->verbose, "One line per frame instead of the progress line");
   addViewerOptions(cmd, o->live);
+  addSecureOption(cmd, o->secure);
   cmd->add_flag("--viewer-wait", o->viewer_wait, "With --viewer: keep serving the page after the run, until Ctrl-C");
   cmd->add_flag("--ros", o->live.ros, "Publish the ROS 2 visualization topics (/hiveslam/<name>/pose, path, tf, points, keyframe_markers, status) on --domain");
   cmd->add_option("--name", o->live.node, "With --ros or --viewer: the name in topic names and on the page")->capture_default_str();
-  cmd->callback([o]() { fmt::print("{}\n", runSlam(*o).line); });
+  cmd->callback([o]() {
+    useSecureOption(o->secure, "tr");  // a standalone system is a tracking node
+    fmt::print("{}\n", runSlam(*o).line);
+  });
 }
 
 }  // namespace hiveslam::apps

@@ -3,6 +3,7 @@
 // report.json and plot out.
 #include <nlohmann/json.hpp>
 
+#include "apps/secure_option.hpp"
 #include "core/loop/loop_closer.hpp"
 #include "core/mapping/local_mapper.hpp"
 #include "apps/live_view_stack.hpp"
@@ -31,6 +32,7 @@ struct RunOptions {
   // The live view (web page, ROS 2 topics); a TR node publishes the topics unless told not to.
   LiveViewOptions live;
   bool viewer_wait = false;  // keep serving the page after the run, until Ctrl-C
+  SecureOption secure;        // DDS Security for the image topic and the ROS 2 topics (run --secure)
   // As the TR node of a distributed system (hiveslam node --task tr): on a DDS domain, waiting
   // for the peers it expects before the first frame.
   struct Network {
@@ -50,6 +52,9 @@ nlohmann::json loopEventsJson(const core::LoopStats& stats);
 nlohmann::json remeasureJson(const core::SlamSystem::RemeasureReport& r, const core::RemeasurementUse& use);
 // Local mapping's counts (keyframes processed and culled, points made and culled, local BAs).
 nlohmann::json mappingStatsJson(const core::MappingStats& stats);
+// A node's DDS Security: "secure" (joined with --secure) and "failed_handshakes" (remote
+// participants that could not authenticate: no keys, or another domain's).
+void addSecurityReport(nlohmann::json& report);
 
 struct RunSummary {
   nlohmann::json report;  // what report.json holds

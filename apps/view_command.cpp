@@ -9,6 +9,7 @@
 #include <thread>
 
 #include "apps/commands.hpp"
+#include "apps/secure_option.hpp"
 #include "common/error.hpp"
 #include "io/slam_settings_io.hpp"
 #include "viz/live_view.hpp"
@@ -26,11 +27,13 @@ struct ViewOptions {
   int domain = 0, port = 8080;
   std::string host = "127.0.0.1", config;
   double seconds = 0;  // 0: until Ctrl-C
+  SecureOption secure;
 };
 
 void serveView(const ViewOptions& o) {
   viz::ViewSettings settings;
   if (!o.config.empty()) io::applyViewSettings(o.config, settings);
+  useSecureOption(o.secure, "view");
   viz::LiveView view;
   viz::ros::RosVizReader reader(view, o.domain);
   viz::web::WebViewer web(view, o.host, o.port, settings);
@@ -57,6 +60,7 @@ void addViewCommand(CLI::App& app) {
   cmd->add_option("--host", o->host, "Address to listen on (0.0.0.0: every interface)")->capture_default_str();
   cmd->add_option("--config", o->config, "Settings YAML: its view section sets the rates and the page's byte budget");
   cmd->add_option("--seconds", o->seconds, "Stop after this many seconds (default: at Ctrl-C)");
+  addSecureOption(cmd, o->secure);
   cmd->callback([o] {
     if (o->domain < 0 || o->domain > 232) throw InputError("DDS domain must be 0-232");
     if (o->port < 0 || o->port > 65535) throw InputError("viewer port must be 0-65535");

@@ -33,6 +33,7 @@
 #include "common/blocking_queue.hpp"
 #include "common/error.hpp"
 #include "common/thread_name.hpp"
+#include "communication/dds/participant_security.hpp"
 #include "hiveslam_msgs/msg/NodeInfoPubSubTypes.h"
 #include "hiveslam_msgs/msg/PacketPubSubTypes.h"
 
@@ -100,6 +101,8 @@ struct DdsTransport::Impl : public dds::DomainParticipantListener {
   // from then on never waits for the teardown (which may hold `entities` long, or for good).
   std::atomic<bool> stopping{false};
   std::array<dds::DataWriter*, kTopicCount> writers{};
+  // Topics this node's permissions do not let it write (a secure domain): asked once.
+  std::array<bool, kTopicCount> denied{};
   struct Reader;
   std::array<std::unique_ptr<Reader>, kTopicCount> readers;
   std::mutex mutex;  // guards everything below
@@ -202,6 +205,14 @@ struct DdsTransport::Impl : public dds::DomainParticipantListener {
     peer_events.push({p, !p.leaving});
   }
 
+  // A remote participant that could not prove an identity of this domain's CA (no keys, other
+  // keys): never matched, counted for the report.
+  void onParticipantAuthentication(dds::DomainParticipant*, eprosima::fastrtps::rtps::ParticipantAuthenticationInfo&& info) override {
+    if (info.status != eprosima::fastrtps::rtps::ParticipantAuthenticationInfo::UNAUTHORIZED_PARTICIPANT) return;
+    noteFailedHandshake();
+    spdlog::warn("node {}: a participant failed DDS authentication and is ignored", self_node.load());
+  }
+
   void on_participant_discovery(dds::DomainParticipant*, ParticipantDiscoveryInfo&& info) override {
     if (info.status != ParticipantDiscoveryInfo::REMOVED_PARTICIPANT &&
         info.status != ParticipantDiscoveryInfo::DROPPED_PARTICIPANT)
@@ -219,7 +230,14 @@ struct DdsTransport::Impl : public dds::DomainParticipantListener {
 
   dds::DataWriter* writerFor(Topic t) {
     auto& w = writers[static_cast<size_t>(t)];
-    if (w) return w;
+    if (w || denied[static_cast<size_t>(t)]) return w;
+    if (!mayWrite(topicName(t))) {
+      // The node's grant leaves this topic out: what it would write there is dropped and
+      // counted as failed writes, as a peer would drop it (security/grants.hpp).
+      denied[static_cast<size_t>(t)] = true;
+      spdlog::info("DDS: this node's permissions leave out writing {}", topicName(t));
+      return nullptr;
+    }
     const ScopedThreadName name("fastdds");
     dds::DataWriterQos q = dds::DATAWRITER_QOS_DEFAULT;
     q.reliability().kind = dds::RELIABLE_RELIABILITY_QOS;
@@ -281,8 +299,9 @@ void DdsTransport::start(const PeerInfo& self, PeerHandler on_peer) {
   // Mbps at most.
   pq.transport().use_builtin_transports = false;
   auto udp = std::make_shared<eprosima::fastdds::rtps::UDPv4TransportDescriptor>();
-  udp->maxMessageSize = static_cast<uint32_t>(d.options.max_datagram_bytes);
+  udp->maxMessageSize = static_cast<uint32_t>(d.options.max_datagram_bytes);  // secure: see applySecurity
   pq.transport().user_transports.push_back(udp);
+  applySecurity(pq);
   d.participant = dds::DomainParticipantFactory::get_instance()->create_participant(
       static_cast<dds::DomainId_t>(d.options.domain), pq, &d, dds::StatusMask::none());
   if (!d.participant) throw InputError("DDS: cannot create a participant on domain " + std::to_string(d.options.domain));
@@ -371,13 +390,14 @@ void DdsTransport::publish(Topic topic, Message&& m) {
   // Held through the write: stop() deletes the writers under it.
   std::lock_guard lock(d.entities);
   if (d.closed) return;
-  if (d.writerFor(topic)->write(&p)) {
+  dds::DataWriter* writer = d.writerFor(topic);
+  if (writer && writer->write(&p)) {
     d.counter.sent(topic, bytes);
     spdlog::debug("node {}: out {} kind {} map {} seq {} {} B", d.self_node.load(), topicName(topic), p.kind(), p.map_id(),
                   p.seq(), bytes);
   } else {
     d.counter.writeFailed(topic);
-    spdlog::warn("node {}: a write on {} failed ({} bytes)", d.self_node.load(), topicName(topic), bytes);
+    if (writer) spdlog::warn("node {}: a write on {} failed ({} bytes)", d.self_node.load(), topicName(topic), bytes);
   }
 }
 
@@ -400,6 +420,11 @@ void DdsTransport::subscribe(Topic topic, Handler handler) {
   q.reliability().kind = dds::RELIABLE_RELIABILITY_QOS;
   q.history().kind = dds::KEEP_LAST_HISTORY_QOS;
   q.history().depth = d.options.history_depth;
+  if (!mayRead(topicName(topic))) {
+    spdlog::warn("DDS: this node's permissions do not allow reading {}", topicName(topic));
+    r.reset();
+    return;
+  }
   r->reader = d.subscriber->create_datareader(d.topics[static_cast<size_t>(topic)], q, r.get());
   if (!r->reader) throw InputError(std::string("DDS: cannot subscribe to ") + topicName(topic));
 }

@@ -13,6 +13,8 @@
 #include <fastdds/dds/subscriber/qos/DataReaderQos.hpp>
 #include <fastdds/dds/topic/Topic.hpp>
 #include <fastdds/dds/topic/TypeSupport.hpp>
+#include <fastdds/rtps/transport/UDPv4TransportDescriptor.h>
+#include <fastdds/rtps/transport/shared_mem/SharedMemTransportDescriptor.h>
 
 #include <algorithm>
 #include <cctype>
@@ -22,6 +24,7 @@
 
 #include "common/error.hpp"
 #include "common/thread_name.hpp"
+#include "communication/dds/participant_security.hpp"
 #include "sensor_msgs/msg/ImagePubSubTypes.h"
 
 namespace hiveslam::communication {
@@ -59,6 +62,12 @@ struct ImageParticipant {
     dds::DomainParticipantQos pq = dds::PARTICIPANT_QOS_DEFAULT;
     pq.wire_protocol().builtin.discovery_config.initial_announcements.count = 5;
     pq.wire_protocol().builtin.discovery_config.initial_announcements.period = Duration_t(0, 100'000'000);
+    if (secure()) {  // the same transports, made here so that applySecurity sizes the UDP one
+      pq.transport().use_builtin_transports = false;
+      pq.transport().user_transports.push_back(std::make_shared<eprosima::fastdds::rtps::SharedMemTransportDescriptor>());
+      pq.transport().user_transports.push_back(std::make_shared<eprosima::fastdds::rtps::UDPv4TransportDescriptor>());
+    }
+    applySecurity(pq);
     participant = dds::DomainParticipantFactory::get_instance()->create_participant(
         static_cast<dds::DomainId_t>(domain), pq);
     if (!participant) throw InputError("DDS: cannot create a participant on domain " + std::to_string(domain));

@@ -11,6 +11,7 @@
 
 #include "common/error.hpp"
 #include "common/thread_name.hpp"
+#include "communication/dds/participant_security.hpp"
 
 namespace hiveslam::communication {
 
@@ -61,6 +62,7 @@ TopicDiscovery::TopicDiscovery(int domain) : impl_(std::make_unique<Impl>()) {
   discovery.initial_announcements.count = 5;
   discovery.initial_announcements.period = eprosima::fastrtps::Duration_t(0, 100'000'000);
   dds::StatusMask mask = dds::StatusMask::none();
+  applySecurity(pq);
   impl_->participant = dds::DomainParticipantFactory::get_instance()->create_participant(
       static_cast<dds::DomainId_t>(domain), pq, impl_.get(), mask);
   if (!impl_->participant) throw InputError("DDS: cannot create a participant on domain " + std::to_string(domain));

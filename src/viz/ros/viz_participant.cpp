@@ -13,6 +13,7 @@
 
 #include "common/error.hpp"
 #include "common/thread_name.hpp"
+#include "communication/dds/participant_security.hpp"
 
 namespace hiveslam::viz::ros {
 
@@ -54,6 +55,7 @@ VizParticipant::VizParticipant(int domain, const std::string& name) : impl_(std:
   auto& discovery = pq.wire_protocol().builtin.discovery_config;
   discovery.initial_announcements.count = 5;
   discovery.initial_announcements.period = eprosima::fastrtps::Duration_t(0, 100'000'000);
+  communication::applySecurity(pq);
   impl_->participant = dds::DomainParticipantFactory::get_instance()->create_participant(
       static_cast<dds::DomainId_t>(domain), pq);
   if (!impl_->participant) throw InputError("DDS: cannot create a participant on domain " + std::to_string(domain));
