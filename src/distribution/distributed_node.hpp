@@ -207,6 +207,8 @@ class DistributedNode final : public core::SystemEvents {
   int departures_ = 0, departures_handled_ = 0;  // peers that left; of those, handled in order
   uint64_t knownEpoch(core::Id map) const;  // the newer of synced_ and published_; mutex_ held
   void releaseHeld(core::Id map);           // applies the held local maps the epoch has reached
+  // A global map taken whole whatever its labels (StateIntegrator::adoptGlobal), `why` logged.
+  void adoptWhole(const std::vector<MapRecord>& batches, uint16_t source, const char* why);
   std::thread finisher_;  // the end-of-run exchange (LM, LC)
   // Peers that departed (their lease ran out, or they left), by node: the incarnation that
   // went. The same incarnation back is a partition that healed, not a restart. Guarded by mutex_.

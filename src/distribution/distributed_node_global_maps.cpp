@@ -52,16 +52,7 @@ void DistributedNode::onGlobal(std::vector<MapRecord>&& batches, Topic topic, ui
     // meanwhile, and this node's, older, moved on under labels of its own (LC's global BAs of
     // the map as it was). Judged by labels, TR's map was taken for the older one: a 30 s cut of
     // TR from LM and LC ended at 2.8% of the path against 0.03% uncut.
-    integrator_.adoptGlobal(batches);
-    {
-      std::lock_guard lock(mutex_);
-      synced_[map_id] = epoch;
-      if (published_.count(map_id)) published_[map_id] = epoch;
-      std::erase_if(held_, [&](const MapRecord& m) { return m.map == map_id && m.epoch > epoch; });
-    }
-    spdlog::info("node {}: map {} taken whole from node {}, back from a partition (epoch {})", options_.id, map_id,
-                 source, epoch);
-    releaseHeld(map_id);
+    adoptWhole(batches, source, "back from a partition");
     return;
   }
   if (topic == Topic::LcMap) {
@@ -79,17 +70,26 @@ void DistributedNode::onGlobal(std::vector<MapRecord>&& batches, Topic topic, ui
     releaseHeld(map_id);
     return;
   }
-  bool ignore = false;
+  bool ignore = false, newer = false;
   {
     std::lock_guard lock(mutex_);
     auto it = published_.find(map_id);
+    // A relay newer than LC's latest update: the gateway's map went on past LC's corrections
+    // without it (it took a tracking node's map whole, back from a partition of TR from both;
+    // TR's own copy to LC was cut short when TR left). Judged by labels it was ignored, and LC
+    // ended with 16 of TR's 85 keyframes.
+    newer = it != published_.end() && epoch > it->second;
     // LC takes the relay of its latest update only: an older one would undo a newer correction.
-    if (it != published_.end() && it->second != epoch) {
+    if (!newer && it != published_.end() && it->second != epoch) {
       ++globals_ignored_;
       ignore = true;
       spdlog::info("node {}: global map {} of epoch {} ignored (this node published epoch {})", options_.id, map_id,
                    epoch, it->second);
     }
+  }
+  if (newer) {
+    adoptWhole(batches, source, "newer than this node's corrections");
+    return;
   }
   if (!ignore && integrator_.applyGlobal(batches, true)) {
     {
@@ -114,6 +114,20 @@ void DistributedNode::onGlobal(std::vector<MapRecord>&& batches, Topic topic, ui
     std::lock_guard lock(a.map->mutex);
     core::insertKeyframe(*a.map, *a.keyframe, slam_.scales(), &slam_.database());
   }
+}
+
+void DistributedNode::adoptWhole(const std::vector<MapRecord>& batches, uint16_t source, const char* why) {
+  const core::Id map_id = batches.front().map;
+  const uint64_t epoch = batches.front().epoch;
+  integrator_.adoptGlobal(batches);
+  {
+    std::lock_guard lock(mutex_);
+    synced_[map_id] = epoch;
+    if (published_.count(map_id)) published_[map_id] = epoch;
+    std::erase_if(held_, [&](const MapRecord& m) { return m.map == map_id && m.epoch > epoch; });
+  }
+  spdlog::info("node {}: map {} taken whole from node {}, {} (epoch {})", options_.id, map_id, source, why, epoch);
+  releaseHeld(map_id);
 }
 
 uint64_t DistributedNode::knownEpoch(core::Id map) const {
