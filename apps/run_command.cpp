@@ -103,9 +103,11 @@ std::atomic<bool> g_interrupted{false};
 extern "C" void onInterrupt(int) { g_interrupted = true; }
 
 void waitForInterrupt(const std::string& message) {
-  fmt::print(stderr, "{}\n", message);
+  // The handlers first: a script that waits for the message and then interrupts must not find
+  // SIGINT still ignored (bash starts a background job so).
   auto previous_int = std::signal(SIGINT, onInterrupt);
   auto previous_term = std::signal(SIGTERM, onInterrupt);
+  fmt::print(stderr, "{}\n", message);
   while (!g_interrupted) std::this_thread::sleep_for(std::chrono::milliseconds(100));
   std::signal(SIGINT, previous_int);
   std::signal(SIGTERM, previous_term);

@@ -227,6 +227,9 @@ TEST(LiveViewProcesses, TheWebPageDrawsTheMapAndItsCountsRise) {
   const int first = count();
   const int second = count();
   run(browser + " --screenshot=" + (out / "page.png").string() + " '" + url + "?panels=3' 2>/dev/null");
+  // Ctrl-C once the run is over: before, it comes while SIGINT is still ignored (bash starts a
+  // background job so), and the page then stayed up for good (a CI run hung here).
+  waitUntil([&] { return slurp(out / "run.log").find("run over") != std::string::npos; }, std::chrono::seconds(120));
   std::system(("kill -INT $(cat " + (out / "pid").string() + ")").c_str());
   slam.join();
   const cv::Mat shot = cv::imread((out / "page.png").string());
