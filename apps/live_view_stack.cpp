@@ -2,8 +2,10 @@
 
 #include <fmt/format.h>
 
+#include "communication/dds/participant_security.hpp"
 #include "viz/live_view.hpp"
 #include "viz/local_feed.hpp"
+#include "viz/ros/ros_messages.hpp"
 #include "viz/ros/ros_viz_publisher.hpp"
 #include "viz/web/web_viewer.hpp"
 
@@ -23,7 +25,13 @@ LiveViewStack::LiveViewStack(const LiveViewOptions& o, core::SlamSystem& slam, s
     web_ = std::make_unique<viz::web::WebViewer>(*view_, o.viewer_host, o.viewer_port, o.settings);
     fmt::print(stderr, "live view: http://{}:{}/\n", o.viewer_host == "0.0.0.0" ? "localhost" : o.viewer_host, web_->port());
   }
-  if (o.ros) ros_ = std::make_unique<viz::ros::RosVizPublisher>(*view_, o.domain, o.node, o.settings, std::move(publishes_map));
+  // A secure identity may write only its own name's topics: under another name they would be
+  // refused one by one, on the publisher's thread.
+  const bool ros_allowed = communication::mayWrite(viz::ros::vizTopic(o.node, "pose"));
+  if (o.ros && !ros_allowed)
+    fmt::print(stderr, "warning: this identity's permissions leave out /hiveslam/{}/...: no ROS 2 topics\n", o.node);
+  if (o.ros && ros_allowed)
+    ros_ = std::make_unique<viz::ros::RosVizPublisher>(*view_, o.domain, o.node, o.settings, std::move(publishes_map));
   // Last: its thread asks the page and the topics whether anyone reads the maps.
   feed_ = std::make_unique<viz::LocalFeed>(*view_, o.node, slam, o.settings, std::move(node_report), [this] {
     return (web_ && web_->pages() > 0) || (ros_ && ros_->wantsMap());

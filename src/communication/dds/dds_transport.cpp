@@ -411,6 +411,10 @@ void DdsTransport::subscribe(Topic topic, Handler handler) {
   if (d.closed) return;
   auto& r = d.readers[static_cast<size_t>(topic)];
   if (r) return;  // one handler per topic for the life of the reader
+  if (!mayRead(topicName(topic))) {
+    spdlog::warn("DDS: this node's permissions do not allow reading {}", topicName(topic));
+    return;
+  }
   r = std::make_unique<Impl::Reader>();
   r->impl = &d;
   r->topic = topic;
@@ -420,11 +424,6 @@ void DdsTransport::subscribe(Topic topic, Handler handler) {
   q.reliability().kind = dds::RELIABLE_RELIABILITY_QOS;
   q.history().kind = dds::KEEP_LAST_HISTORY_QOS;
   q.history().depth = d.options.history_depth;
-  if (!mayRead(topicName(topic))) {
-    spdlog::warn("DDS: this node's permissions do not allow reading {}", topicName(topic));
-    r.reset();
-    return;
-  }
   r->reader = d.subscriber->create_datareader(d.topics[static_cast<size_t>(topic)], q, r.get());
   if (!r->reader) throw InputError(std::string("DDS: cannot subscribe to ") + topicName(topic));
 }

@@ -17,6 +17,11 @@ std::atomic<int> g_failed{0};
 
 std::string fileUri(const std::filesystem::path& p) { return "file://" + p.string(); }
 
+bool granted(const std::vector<std::string>& patterns, const std::string& name) {
+  // fnmatch without FNM_PATHNAME: '*' crosses '/', as in Fast DDS's own matching.
+  return std::any_of(patterns.begin(), patterns.end(), [&](const std::string& p) { return fnmatch(p.c_str(), name.c_str(), 0) == 0; });
+}
+
 }  // namespace
 
 void useSecurity(std::optional<security::SecureIdentity> identity) {
@@ -47,15 +52,6 @@ void applySecurity(eprosima::fastdds::dds::DomainParticipantQos& qos) {
     if (auto udp = std::dynamic_pointer_cast<eprosima::fastdds::rtps::UDPv4TransportDescriptor>(t))
       udp->maxMessageSize = kSecureDatagramBytes;
 }
-
-namespace {
-
-bool granted(const std::vector<std::string>& patterns, const std::string& name) {
-  // fnmatch without FNM_PATHNAME: '*' crosses '/', as in Fast DDS's own matching.
-  return std::any_of(patterns.begin(), patterns.end(), [&](const std::string& p) { return fnmatch(p.c_str(), name.c_str(), 0) == 0; });
-}
-
-}  // namespace
 
 bool mayWrite(const std::string& name) {
   std::lock_guard lock(g_mutex);
