@@ -282,6 +282,7 @@ RunSummary runSlam(const RunOptions& o) {
   report["tracked_frames"] = tracked;
   report["frames_refined"] = frames_refined;
   report["failures"] = slam.failures();
+  report["relocalized_in_known_map"] = slam.relocalizedInKnownMap();
   report["keyframes_deferred"] = slam.keyframesDeferred();
   report["keyframes_made_busy"] = slam.keyframesMadeBusy();
   report["keyframes"] = keyframe_count;

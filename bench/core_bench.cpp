@@ -5,12 +5,14 @@
 // `hiveslam run --realtime`'s tracking_ms (docs/BENCHMARKS.md).
 #include <benchmark/benchmark.h>
 
+#include <opencv2/calib3d.hpp>
 #include <opencv2/core/utility.hpp>
 
 #include "core/camera/pinhole_radtan.hpp"
 #include <random>
 
 #include "core/frame/frame.hpp"
+#include "core/geometry/pnp_ransac.hpp"
 #include "core/geometry/sim3_solver.hpp"
 #include "core/optim/bundle_adjustment.hpp"
 #include "core/optim/pose_graph.hpp"
@@ -116,6 +118,45 @@ void Sim3Ransac(benchmark::State& state) {
   for (auto _ : state) benchmark::DoNotOptimize(hiveslam::core::solveSim3Ransac(K, K, m));
 }
 BENCHMARK(Sim3Ransac)->Arg(50)->Arg(200)->Unit(benchmark::kMicrosecond);
+
+// Relocalization's PnP on 30 2D-3D matches of which state.range(0) percent are right: most
+// candidates are the wrong place (15%), a right one holds 35-70%. PnpRansacClassic is the OpenCV
+// RANSAC with EPnP that relocalization used before, for comparison.
+std::vector<hiveslam::core::PnpMatch> pnpMatches(int right_percent) {
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> u(-1, 1);
+  const hiveslam::core::Intrinsics K{500, 500, 320, 240};
+  std::vector<hiveslam::core::PnpMatch> m;
+  for (int i = 0; i < 30; ++i) {
+    const Eigen::Vector3d p(u(rng), u(rng), 3 + u(rng));
+    const Eigen::Vector2d noise(u(rng), u(rng));
+    m.push_back({p, i * 100 < right_percent * 30 ? K.project(p) + noise : Eigen::Vector2d(320 + 300 * u(rng), 240 + 200 * u(rng))});
+  }
+  return m;
+}
+void PnpRansac(benchmark::State& state) {
+  const auto m = pnpMatches(static_cast<int>(state.range(0)));
+  int seed = 0;
+  for (auto _ : state)
+    benchmark::DoNotOptimize(hiveslam::core::solvePnpRansac({500, 500, 320, 240}, m, 4.0, 10, ++seed));
+}
+BENCHMARK(PnpRansac)->Arg(15)->Arg(35)->Arg(70)->Unit(benchmark::kMicrosecond);
+void PnpRansacClassic(benchmark::State& state) {
+  const auto m = pnpMatches(static_cast<int>(state.range(0)));
+  std::vector<cv::Point3d> object;
+  std::vector<cv::Point2d> image;
+  for (const auto& x : m) {
+    object.emplace_back(x.p_w.x(), x.p_w.y(), x.p_w.z());
+    image.emplace_back(x.uv.x(), x.uv.y());
+  }
+  const cv::Matx33d K(500, 0, 320, 0, 500, 240, 0, 0, 1);
+  for (auto _ : state) {
+    cv::Mat rvec, tvec, inliers;
+    benchmark::DoNotOptimize(cv::solvePnPRansac(object, image, K, cv::noArray(), rvec, tvec, false, 300, 4.0f, 0.99,
+                                                inliers, cv::SOLVEPNP_EPNP));
+  }
+}
+BENCHMARK(PnpRansacClassic)->Arg(15)->Arg(35)->Arg(70)->Unit(benchmark::kMicrosecond);
 
 // Essential graph of N keyframes around a circle: a chain plus covisibility edges to the next
 // three, one loop edge, drift to spread.

@@ -56,6 +56,7 @@ KeyTable slamKeys(core::SlamSettings& s) {
       {"keyframe_turn_deg", set(s.keyframe_turn_deg)},
       {"keyframe_min_inliers", set(s.keyframe_min_inliers)},
       {"lost_frames_before_new_map", set(s.lost_frames_before_new_map)},
+      {"relocalize_in_every_map", set(s.relocalize_in_every_map)},
       {"triangulation_neighbours", set(s.triangulation_neighbours)},
       {"triangulation_max_cos_parallax", set(s.triangulation_max_cos_parallax)},
       {"triangulation_by_vocabulary", set(s.triangulation_by_vocabulary)},

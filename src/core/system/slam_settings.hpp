@@ -42,6 +42,9 @@ struct SlamSettings {
   // Loss handling: a new map after this many lost frames once the map is past its first
   // keyframes (the paper's wait for the initial keyframes to be optimized).
   int lost_frames_before_new_map = 20;
+  // A lost tracker, and one about to start a new map, relocalizes in every map of the atlas,
+  // not only in the one it lost: a revisit continues the map made there.
+  bool relocalize_in_every_map = true;
   // Local mapping
   // Neighbours searched for new points (and, below, for duplicates). ORB-SLAM's monocular value
   // is 20; 20 here helped the sequential runs (median ATE at six feature budgets: figure8 10.6 ->

@@ -38,6 +38,13 @@ SlamSystem::SlamSystem(const SlamSettings& settings, std::shared_ptr<const camer
   if (vocabulary_ && !vocabulary_->empty()) {
     tracker_.setPlaceRecognition(vocabulary_.get(), &database_);
     mapper_.setDatabase(&database_);
+    if (settings_.relocalize_in_every_map)
+      tracker_.setMapFinder([this](const Map* place_map) -> std::shared_ptr<Map> {
+        std::lock_guard lock(atlas_mutex_);
+        for (const auto& m : maps_)
+          if (m.get() == place_map) return m->merged_into.load() ? nullptr : m;
+        return nullptr;
+      });
   }
   hosting_loop_closing_ = settings_.loop_closing;
   closer_.setActiveMap(&active_map_);
@@ -295,6 +302,7 @@ const FrameRecord& SlamSystem::process(const cv::Mat& gray, double timestamp) {
     active_map_ = out.new_map.get();
     if (events_) events_->mapCreated(out.new_map);
   }
+  if (out.map_switched) active_map_ = tracker_.map().get();
   r.inliers = out.inliers;
   r.keyframe = out.new_keyframe != nullptr;
   if (out.tracked && out.reference) {

@@ -129,6 +129,7 @@ class SlamSystem {
   const std::vector<FrameRecord>& frames() const { return records_; }
   std::vector<std::shared_ptr<Map>> maps() const;
   int failures() const { return tracker_.failures(); }
+  int relocalizedInKnownMap() const { return tracker_.relocalizedInKnownMap(); }
   int keyframesDeferred() const { return tracker_.keyframesDeferred(); }
   int keyframesMadeBusy() const { return tracker_.keyframesMadeBusy(); }
   const MappingStats& mappingStats() const { return mapper_.stats(); }

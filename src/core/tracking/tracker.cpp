@@ -2,11 +2,11 @@
 
 #include <algorithm>
 #include <limits>
-#include <opencv2/calib3d.hpp>
 #include <set>
 #include <unordered_set>
 
 #include "core/features/hamming.hpp"
+#include "core/geometry/pnp_ransac.hpp"
 #include "core/geometry/two_view.hpp"
 #include "core/mapping/keyframe_gap.hpp"
 #include "core/matching/bow_matcher.hpp"
@@ -26,25 +26,34 @@ TrackingOutput Tracker::track(Frame frame, bool mapping_idle) {
   current.outlier.assign(frame.size(), false);
   current.frame = std::move(frame);
 
-  if (state_ == TrackingState::NotInitialized) {
-    if (initialize(current, out)) {
-      state_ = TrackingState::Ok;
-      out.tracked = true;
-      last_relocalization_frame_.reset();  // a new map: nothing relocalized in it
-    }
-    out.state = state_;
-    return out;
-  }
-
-  std::unique_lock lock(map_->mutex);
-  // Loop closing, a merge or a global BA moved the map: the last frame's pose is re-derived
-  // from its reference keyframe, as the motion model predicts from it.
-  if (map_->epoch != epoch_seen_) {
-    if (last_ && last_reference_) last_->T_cw = last_reference_->poseOf(last_T_c_ref_);
-    epoch_seen_ = map_->epoch;
-  }
+  std::unique_lock<std::mutex> lock;
   bool ok = false;
-  if (state_ == TrackingState::Ok) {
+  if (state_ == TrackingState::NotInitialized) {
+    // Before a new map: the frame may show a place a map already holds (the one just lost
+    // included), and tracking goes on there.
+    ok = !localization_only_ && map_finder_ && relocalizeInKnownMap(current, queryPlaces(current.frame), nullptr, lock);
+    if (!ok) {
+      if (initialize(current, out)) {
+        state_ = TrackingState::Ok;
+        out.tracked = true;
+        last_relocalization_frame_.reset();  // a new map: nothing relocalized in it
+      }
+      out.state = state_;
+      return out;
+    }
+    out.map_switched = true;
+  } else {
+    lock = std::unique_lock(map_->mutex);
+    // Loop closing, a merge or a global BA moved the map: the last frame's pose is re-derived
+    // from its reference keyframe, as the motion model predicts from it.
+    if (map_->epoch != epoch_seen_) {
+      if (last_ && last_reference_) last_->T_cw = last_reference_->poseOf(last_T_c_ref_);
+      epoch_seen_ = map_->epoch;
+    }
+  }
+  if (out.map_switched) {
+    last_relocalization_frame_ = current.frame.index;
+  } else if (state_ == TrackingState::Ok) {
     ok = (have_velocity_ && trackWithMotionModel(current)) || trackReferenceKeyframe(current);
     if (ok) ok = trackLocalMap(current, relocalizedWithin(current.frame, 20) ? settings_.min_inliers_after_relocalization
                                                                               : settings_.min_inliers_tracking);
@@ -53,7 +62,15 @@ TrackingOutput Tracker::track(Frame frame, bool mapping_idle) {
       lost_frames_ = 0;
     }
   } else {
-    ok = relocalize(current);
+    const PlaceQuery q = queryPlaces(current.frame);
+    ok = relocalize(current, relocalizationCandidates(q, *map_, 10), q.features);
+    if (!ok && !localization_only_ && map_finder_) {
+      const Map* lost_in = map_.get();
+      lock.unlock();
+      ok = relocalizeInKnownMap(current, q, lost_in, lock);
+      out.map_switched = ok;
+      if (!ok) lock = std::unique_lock(map_->mutex);
+    }
     if (ok) {
       last_relocalization_frame_ = current.frame.index;
     }
@@ -64,8 +81,12 @@ TrackingOutput Tracker::track(Frame frame, bool mapping_idle) {
     have_velocity_ = false;
     ++lost_frames_;
     // A young map that loses track is abandoned at once; an established one gets a few frames
-    // to relocalize before a new map is started.
-    if (!localization_only_ && (keyframes_made_ <= 5 || lost_frames_ > settings_.lost_frames_before_new_map)) {
+    // to relocalize before a new map is started. So is a relocalization that held only a few
+    // frames: starting a new map goes on relocalizing in every map, and on phone_room_droidcam
+    // the 20-frame wait after a one-frame relocalization in blur cost 19 frames.
+    const bool brief_relocalization = map_finder_ && relocalizedWithin(current.frame, 10);
+    if (!localization_only_ &&
+        (keyframes_made_ <= 5 || brief_relocalization || lost_frames_ > settings_.lost_frames_before_new_map)) {
       lock.unlock();
       state_ = TrackingState::NotInitialized;
       init_reference_.reset();
@@ -371,44 +392,46 @@ bool Tracker::trackLocalMap(Tracked& c, int min_inliers) {
   return inliers_ >= min_inliers;
 }
 
-std::vector<std::shared_ptr<KeyFrame>> Tracker::relocalizationCandidates(const Frame& frame,
-                                                                        place::FeatureVector& features) const {
+Tracker::PlaceQuery Tracker::queryPlaces(const Frame& frame) const {
+  PlaceQuery q;
+  if (!vocabulary_ || !database_) return q;
+  place::BowVector bow;
+  vocabulary_->transform(frame.descriptors, bow, q.features);
+  q.places = database_->query(bow, {});
+  return q;
+}
+
+std::vector<std::shared_ptr<KeyFrame>> Tracker::relocalizationCandidates(const PlaceQuery& q, const Map& map,
+                                                                        size_t max) const {
   std::vector<std::shared_ptr<KeyFrame>> kfs;
   if (vocabulary_ && database_) {
     // Keyframes of this map that look like the frame, best first.
-    place::BowVector bow;
-    vocabulary_->transform(frame.descriptors, bow, features);
-    for (const auto& c : database_->query(bow, {})) {
-      if (c.map != map_.get() || c.keyframe->bad) continue;
-      auto it = map_->keyframes.find(c.keyframe->id);
-      if (it != map_->keyframes.end()) kfs.push_back(it->second);
-      if (kfs.size() >= 10) break;
+    for (const auto& c : q.places) {
+      if (c.map != &map || c.keyframe->bad) continue;
+      auto it = map.keyframes.find(c.keyframe->id);
+      if (it != map.keyframes.end()) kfs.push_back(it->second);
+      if (kfs.size() >= max) break;
     }
     return kfs;
   }
   // Without a vocabulary: a spread of the keyframes, most recent first.
   std::vector<std::shared_ptr<KeyFrame>> all;
-  for (const auto& [id, kf] : map_->keyframes) all.push_back(kf);
+  for (const auto& [id, kf] : map.keyframes) all.push_back(kf);
   std::sort(all.begin(), all.end(), [](const auto& a, const auto& b) { return a->id > b->id; });
   const size_t stride = std::max<size_t>(1, all.size() / 20);
   for (size_t k = 0; k < all.size(); k += stride) kfs.push_back(all[k]);
   return kfs;
 }
 
-bool Tracker::relocalize(Tracked& c) {
-  place::FeatureVector features;
-  const auto kfs = relocalizationCandidates(c.frame, features);
+bool Tracker::relocalize(Tracked& c, const std::vector<std::shared_ptr<KeyFrame>>& kfs,
+                         const place::FeatureVector& features) {
   for (size_t k = 0; k < kfs.size(); ++k) {
     const KeyFrame& kf = *kfs[k];
-    std::vector<cv::Point3d> object;
-    std::vector<cv::Point2d> image;
-    std::vector<int> index;
+    std::vector<PnpMatch> matches;
     PointSlots slots(c.frame.size());
     auto add = [&](int i, const std::shared_ptr<MapPoint>& p) {
       slots[static_cast<size_t>(i)] = p;
-      object.emplace_back(p->position.x(), p->position.y(), p->position.z());
-      image.emplace_back(c.frame.points[static_cast<size_t>(i)].x(), c.frame.points[static_cast<size_t>(i)].y());
-      index.push_back(i);
+      matches.push_back({p->position, c.frame.points[static_cast<size_t>(i)]});
     };
     if (!features.empty() && !kf.bow_features.empty()) {
       const std::vector<int> m = matchFrameByBow(c.frame, features, kf);
@@ -425,26 +448,55 @@ bool Tracker::relocalize(Tracked& c) {
         add(near.index, p);
       }
     }
-    if (object.size() < 15) continue;
-    cv::Mat rvec, tvec, inliers;
-    const cv::Matx33d K(c.frame.K.fx, 0, c.frame.K.cx, 0, c.frame.K.fy, c.frame.K.cy, 0, 0, 1);
-    cv::setRNGSeed(static_cast<int>((settings_.seed + c.frame.index) & 0x7fffffff));
-    if (!cv::solvePnPRansac(object, image, K, cv::noArray(), rvec, tvec, false, 300, 4.0f, 0.99, inliers,
-                            cv::SOLVEPNP_EPNP) ||
-        inliers.rows < 10)
-      continue;
-    cv::Mat R;
-    cv::Rodrigues(rvec, R);
-    Eigen::Matrix3d Re;
-    for (int r = 0; r < 3; ++r)
-      for (int q = 0; q < 3; ++q) Re(r, q) = R.at<double>(r, q);
-    c.T_cw.linear() = Re;
-    c.T_cw.translation() = Eigen::Vector3d(tvec.at<double>(0), tvec.at<double>(1), tvec.at<double>(2));
+    if (matches.size() < 15) continue;
+    const auto pose = solvePnpRansac(c.frame.K, matches, 4.0, 10, static_cast<int>((settings_.seed + c.frame.index) & 0x7fffffff));
+    if (!pose) continue;
+    c.T_cw = pose->T_cw;
     c.points = slots;
     if (optimize(c) < 10) continue;
     reference_ = kfs[k];
     if (trackLocalMap(c, settings_.min_inliers_after_relocalization)) return true;
   }
+  return false;
+}
+
+bool Tracker::relocalizeInKnownMap(Tracked& c, const PlaceQuery& q, const Map* skip,
+                                   std::unique_lock<std::mutex>& lock) {
+  if (!map_finder_) return false;
+  // The best-scored places outside `skip`, by map in the order of each map's best place: a
+  // handful, as every candidate costs a PnP RANSAC on a frame that is not tracked anyway.
+  constexpr size_t kPlaces = 5;
+  std::vector<std::pair<const Map*, size_t>> maps;  // map, places in it
+  size_t places = 0;
+  for (const auto& p : q.places) {
+    if (p.map == skip || p.keyframe->bad) continue;
+    auto it = std::find_if(maps.begin(), maps.end(), [&](const auto& m) { return m.first == p.map; });
+    if (it == maps.end()) maps.emplace_back(p.map, 1);
+    else ++it->second;
+    if (++places >= kPlaces) break;
+  }
+  const std::shared_ptr<Map> previous = map_;
+  const std::shared_ptr<KeyFrame> previous_reference = reference_;
+  for (const auto& [m, count] : maps) {
+    std::shared_ptr<Map> map = map_finder_(m);
+    if (!map) continue;
+    std::unique_lock candidate_lock(map->mutex);
+    if (map->merged_into.load()) continue;
+    map_ = map;
+    if (relocalize(c, relocalizationCandidates(q, *map, count), q.features)) {
+      lock = std::move(candidate_lock);
+      state_ = TrackingState::Ok;
+      keyframes_made_ = static_cast<int>(map->keyframes.size());
+      epoch_seen_ = map->epoch;
+      init_reference_.reset();
+      last_.reset();
+      have_velocity_ = false;
+      ++relocalized_in_known_map_;
+      return true;
+    }
+  }
+  map_ = previous;
+  reference_ = previous_reference;
   return false;
 }
 

@@ -31,6 +31,7 @@ struct TrackingOutput {
   RelativePose T_c_ref;                     // taken under the map lock
   std::shared_ptr<KeyFrame> new_keyframe;   // for local mapping (also the initial two)
   std::shared_ptr<Map> new_map;             // set when initialization created a map
+  bool map_switched = false;                // relocalized in a map other than the last one
   // This frame is the first view of an initialization attempt: if the attempt succeeds, the new
   // map's first keyframe (its origin) is made of it, and only new_map tells of that keyframe.
   bool initialization_reference = false;
@@ -54,12 +55,17 @@ class Tracker {
     vocabulary_ = vocabulary;
     database_ = database;
   }
+  // The live map a place of the keyframe database belongs to (null if merged away or gone):
+  // with it, a lost tracker relocalizes in every map, not only in the one it lost.
+  void setMapFinder(std::function<std::shared_ptr<Map>(const Map*)> find) { map_finder_ = std::move(find); }
   // Starts lost in a loaded map: the next frames relocalize in it.
   void startInMap(const std::shared_ptr<Map>& map);
   // Localization only: track against the map, never make keyframes or new maps.
   void setLocalizationOnly(bool on) { localization_only_ = on; }
   TrackingState state() const { return state_; }
   int failures() const { return failures_; }
+  // Times tracking went on in a map other than the one it had lost (or was starting).
+  int relocalizedInKnownMap() const { return relocalized_in_known_map_; }
   // Frames at which a keyframe was due but mapping was busy (real-time runs): how often the
   // keyframe decision waited on mapping, local or remote.
   int keyframesDeferred() const { return keyframes_deferred_; }
@@ -79,9 +85,19 @@ class Tracker {
   bool trackWithMotionModel(Tracked& current);
   bool trackReferenceKeyframe(Tracked& current);
   bool trackLocalMap(Tracked& current, int min_inliers);
-  bool relocalize(Tracked& current);
-  std::vector<std::shared_ptr<KeyFrame>> relocalizationCandidates(const Frame& frame,
-                                                                  place::FeatureVector& features) const;
+  // A lost frame's bag of words and the keyframes of every map that look like it, best first.
+  struct PlaceQuery {
+    place::FeatureVector features;
+    std::vector<PlaceCandidate> places;
+  };
+  PlaceQuery queryPlaces(const Frame& frame) const;
+  // At most `max` keyframes of `map` to relocalize against (the caller holds map's mutex).
+  std::vector<std::shared_ptr<KeyFrame>> relocalizationCandidates(const PlaceQuery& q, const Map& map, size_t max) const;
+  bool relocalize(Tracked& current, const std::vector<std::shared_ptr<KeyFrame>>& candidates,
+                  const place::FeatureVector& features);
+  // Relocalizes in the maps (other than `skip`) whose keyframes look most like the frame; on
+  // success map_ is that map and `lock` holds its mutex.
+  bool relocalizeInKnownMap(Tracked& current, const PlaceQuery& q, const Map* skip, std::unique_lock<std::mutex>& lock);
   void describePlace(KeyFrame& kf) const;
   int optimize(Tracked& current);
   // Made, or due but held back because mapping is busy (counted as deferred), or neither.
@@ -123,6 +139,8 @@ class Tracker {
   int keyframes_made_ = 0;
   int keyframes_deferred_ = 0;
   int keyframes_made_busy_ = 0;
+  int relocalized_in_known_map_ = 0;
+  std::function<std::shared_ptr<Map>(const Map*)> map_finder_;
   std::function<void()> wait_for_mapping_;
   const place::Vocabulary* vocabulary_ = nullptr;
   const KeyframeDatabase* database_ = nullptr;
