@@ -17,6 +17,7 @@
 #include "apps/topic_frame_source.hpp"
 #include "common/error.hpp"
 #include "communication/dds/dds_transport.hpp"
+#include "communication/dds/node_announcement.hpp"
 #include "communication/dds/participant_security.hpp"
 #include "distribution/distributed_node.hpp"
 #include "core/system/slam_system.hpp"
@@ -35,6 +36,7 @@ namespace hiveslam::apps {
 void addSecurityReport(nlohmann::json& report) {
   report["secure"] = communication::secure();
   report["failed_handshakes"] = communication::failedHandshakes();
+  report["announcements_dropped"] = communication::droppedAnnouncements();
 }
 
 nlohmann::json mappingStatsJson(const core::MappingStats& ms) {

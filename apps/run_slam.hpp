@@ -53,7 +53,8 @@ nlohmann::json remeasureJson(const core::SlamSystem::RemeasureReport& r, const c
 // Local mapping's counts (keyframes processed and culled, points made and culled, local BAs).
 nlohmann::json mappingStatsJson(const core::MappingStats& stats);
 // A node's DDS Security: "secure" (joined with --secure) and "failed_handshakes" (remote
-// participants that could not authenticate: no keys, or another domain's).
+// participants that could not authenticate: no keys, or another domain's), and
+// "announcements_dropped" (node announcements that failed their checks: communication/dds/node_announcement.hpp).
 void addSecurityReport(nlohmann::json& report);
 
 struct RunSummary {

@@ -1,8 +1,10 @@
 #include "io/atlas_file.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <cstring>
 #include <fstream>
+#include <unordered_set>
 
 #include "common/error.hpp"
 
@@ -56,6 +58,12 @@ class Reader {
     if (!T.matrix().allFinite() || !(R.transpose() * R).isApprox(Eigen::Matrix3d::Identity(), 1e-6))
       throw InputError("corrupt atlas pose: " + file_);
     return T;
+  }
+  // A number the map will compute with: a NaN or an infinity would spread through every BA.
+  double finite(const char* what) {
+    const double v = get<double>();
+    if (!std::isfinite(v)) corrupt(std::string("a ") + what + " that is not a number");
+    return v;
   }
   [[noreturn]] void corrupt(const std::string& why) const { throw InputError("corrupt atlas file (" + why + "): " + file_); }
 
@@ -162,7 +170,7 @@ std::vector<std::shared_ptr<core::Map>> loadAtlas(const std::filesystem::path& f
       const auto id = r.get<core::Id>();
       core::Frame f;
       f.index = r.get<uint64_t>();
-      f.timestamp = r.get<double>();
+      f.timestamp = r.finite("timestamp");
       const Eigen::Isometry3d T_cw = r.pose();
       const auto parent = r.get<core::Id>();
       std::vector<core::Id> loop_ids(r.count(1'000'000, "loop edge"));
@@ -172,10 +180,11 @@ std::vector<std::shared_ptr<core::Map>> loadAtlas(const std::filesystem::path& f
         n = r.get<core::Id>();
         weight = r.get<int32_t>();
       }
-      f.K.fx = r.get<double>();
-      f.K.fy = r.get<double>();
-      f.K.cx = r.get<double>();
-      f.K.cy = r.get<double>();
+      f.K.fx = r.finite("focal length");
+      f.K.fy = r.finite("focal length");
+      f.K.cx = r.finite("principal point");
+      f.K.cy = r.finite("principal point");
+      if (!(f.K.fx > 0) || !(f.K.fy > 0)) r.corrupt("focal length");
       f.width = r.get<int32_t>();
       f.height = r.get<int32_t>();
       if (f.width <= 0 || f.height <= 0 || f.width > 100000 || f.height > 100000) r.corrupt("image size");
@@ -191,7 +200,7 @@ std::vector<std::shared_ptr<core::Map>> loadAtlas(const std::filesystem::path& f
         kp.octave = r.get<int32_t>();
         if (kp.octave < 0 || kp.octave > 31) r.corrupt("keypoint level");
         f.keypoints.push_back(kp);
-        const double x = r.get<double>(), y = r.get<double>();
+        const double x = r.finite("keypoint"), y = r.finite("keypoint");
         f.points.emplace_back(x, y);
         r.bytes(f.descriptors.ptr<uint8_t>(static_cast<int>(i)), 32);
       }
@@ -206,14 +215,14 @@ std::vector<std::shared_ptr<core::Map>> loadAtlas(const std::filesystem::path& f
     for (uint32_t k = 0; k < point_count; ++k) {
       const auto id = r.get<core::Id>();
       Eigen::Vector3d pos;
-      for (int i = 0; i < 3; ++i) pos[i] = r.get<double>();
+      for (int i = 0; i < 3; ++i) pos[i] = r.finite("point position");
       const auto first = r.get<core::Id>();
       auto p = std::make_shared<core::MapPoint>(id, pos, first);
       p->descriptor = cv::Mat(1, 32, CV_8U);
       r.bytes(p->descriptor.ptr<uint8_t>(), 32);
-      for (int i = 0; i < 3; ++i) p->normal[i] = r.get<double>();
-      p->min_distance = r.get<double>();
-      p->max_distance = r.get<double>();
+      for (int i = 0; i < 3; ++i) p->normal[i] = r.finite("point normal");
+      p->min_distance = r.finite("point distance");
+      p->max_distance = r.finite("point distance");
       p->visible = r.get<int32_t>();
       p->found = r.get<int32_t>();
       const uint32_t n = r.count(10'000'000, "observation");
@@ -235,6 +244,15 @@ std::vector<std::shared_ptr<core::Map>> loadAtlas(const std::filesystem::path& f
     for (auto& [kf, parent] : parents) {
       kf->parent = find(parent);
       kf->parent->children.insert(kf);
+    }
+    // A tree: every parent chain ends (loop correction and merging walk it from each keyframe).
+    // Each chain is walked until a keyframe already known to lead to a root.
+    std::unordered_set<const core::KeyFrame*> rooted;
+    for (const auto& [kf, parent] : parents) {
+      std::unordered_set<const core::KeyFrame*> chain;
+      for (const core::KeyFrame* k = kf; k && !rooted.count(k); k = k->parent)
+        if (!chain.insert(k).second) r.corrupt("spanning tree cycle");
+      rooted.insert(chain.begin(), chain.end());
     }
     for (auto& [kf, ids] : loops)
       for (core::Id l : ids) kf->loop_edges.insert(find(l));

@@ -36,6 +36,10 @@ bool jpegComplete(const std::vector<uchar>& b) {
 }  // namespace
 
 cv::Mat readGrayImage(const std::filesystem::path& path) {
+  // A list entry with an empty name is the image folder itself, which ifstream opens and whose
+  // size reads as 2^63 (found by fuzz/dataset_fuzzer.cpp).
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(path, ec)) throw InputError("not an image file: " + path.string());
   std::ifstream in(path, std::ios::binary | std::ios::ate);
   if (!in) throw InputError("cannot open image " + path.string());
   // One read of the whole file (a character-wise copy showed up in the tracking profile).

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <fstream>
 #include <iterator>
+#include <limits>
 
 #include "common/error.hpp"
 #include "core/camera/pinhole_radtan.hpp"
@@ -124,6 +125,39 @@ TEST(Atlas, RejectsMissingTruncatedAndForeignFiles) {
     std::ofstream(dir.path() / "cut.atlas", std::ios::binary) << bytes.substr(0, cut);
     EXPECT_THROW(io::loadAtlas(dir.path() / "cut.atlas"), InputError) << cut;
   }
+}
+
+// What fuzz/dataset_fuzzer.cpp found the loader taking: a point at NaN (it would spread through
+// every BA) and a spanning tree with a cycle (loop correction walks each keyframe's parents).
+TEST(Atlas, RejectsNumbersThatAreNotAndASpanningTreeWithACycle) {
+  const Rendered& r = sweep();
+  SlamSystem slam(SlamSettings{}, r.camera, SlamSystem::Mode::Sequential);
+  for (size_t i = 0; i < 60; ++i) slam.process(r.images[i], r.model.stamp(static_cast<int>(i) + 100));
+  slam.finish();
+  const auto map = slam.largestMap();
+  ASSERT_GE(map->keyframes.size(), 3u);
+  testing::TempDir dir;
+  auto errorOf = [&](const char* name) -> std::string {
+    io::saveAtlas(dir.path() / name, {map});
+    try {
+      io::loadAtlas(dir.path() / name);
+    } catch (const InputError& e) {
+      return e.what();
+    }
+    return "loaded";
+  };
+  MapPoint& point = *map->points.begin()->second;
+  const Eigen::Vector3d position = point.position;
+  point.position.x() = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_NE(errorOf("nan.atlas").find("point position that is not a number"), std::string::npos);
+  point.position = position;
+  // Two keyframes each other's parent.
+  auto it = map->keyframes.begin();
+  KeyFrame& a = *(it++)->second;
+  KeyFrame& b = *it->second;
+  a.parent = &b;
+  b.parent = &a;
+  EXPECT_NE(errorOf("cycle.atlas").find("spanning tree cycle"), std::string::npos);
 }
 
 }  // namespace

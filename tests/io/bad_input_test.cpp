@@ -93,6 +93,17 @@ TEST(BadInput, MissingImageNamesTheFile) {
   EXPECT_NE(errorOf([&] { readAll(dir.path()); }).find(files[3].filename().string()), std::string::npos);
 }
 
+// A file name that starts with a NUL byte names the image folder itself (the system sees the
+// name end there): once read as an image of 2^63 bytes, an allocation failure instead of an
+// error (fuzz/dataset_fuzzer.cpp found it).
+TEST(BadInput, AnImageEntryThatNamesAFolderIsNamed) {
+  testing::TempDir dir;
+  makeSequence(dir);
+  const char list[] = "#timestamp [ns],filename\n1000,\0x.png\n";
+  std::ofstream(dir / "mav0/cam0/data.csv") << std::string(list, sizeof list - 1);
+  EXPECT_NE(errorOf([&] { readAll(dir.path()); }).find("not an image file"), std::string::npos);
+}
+
 TEST(BadInput, TimesOutOfOrderNamesFileAndLine) {
   testing::TempDir dir;
   fs::create_directories(dir / "images");

@@ -33,6 +33,8 @@
 #include "common/blocking_queue.hpp"
 #include "common/error.hpp"
 #include "common/thread_name.hpp"
+#include "communication/dds/checked_type.hpp"
+#include "communication/dds/node_announcement.hpp"
 #include "communication/dds/participant_security.hpp"
 #include "hiveslam_msgs/msg/NodeInfoPubSubTypes.h"
 #include "hiveslam_msgs/msg/PacketPubSubTypes.h"
@@ -48,36 +50,6 @@ namespace {
 
 constexpr const char* kNodeTopic = "rt/hiveslam/nodes";
 
-hiveslam_msgs::msg::NodeInfo toIdl(const PeerInfo& p) {
-  hiveslam_msgs::msg::NodeInfo m;
-  m.version(2);
-  m.node(p.node);
-  m.name(p.name);
-  m.task(static_cast<uint8_t>(p.task));
-  m.hosted(p.hosted);
-  m.incarnation(p.incarnation);
-  m.cores(p.cores);
-  m.load(p.load);
-  m.leaving(p.leaving);
-  // Bounded in the IDL; a network of more nodes than that announces the first of them.
-  m.seen(std::vector<uint16_t>(p.seen.begin(), p.seen.begin() + static_cast<long>(std::min<size_t>(p.seen.size(), 256))));
-  return m;
-}
-
-PeerInfo fromIdl(const hiveslam_msgs::msg::NodeInfo& m) {
-  PeerInfo p;
-  p.node = m.node();
-  p.name = m.name();
-  p.task = static_cast<Task>(std::min<uint8_t>(m.task(), 2));
-  p.hosted = m.hosted();
-  p.incarnation = m.incarnation();
-  p.cores = m.cores();
-  p.load = m.load();
-  p.leaving = m.leaving();
-  p.seen = m.seen();
-  return p;
-}
-
 }  // namespace
 
 struct DdsTransport::Impl : public dds::DomainParticipantListener {
@@ -85,8 +57,8 @@ struct DdsTransport::Impl : public dds::DomainParticipantListener {
   dds::DomainParticipant* participant = nullptr;
   dds::Publisher* publisher = nullptr;
   dds::Subscriber* subscriber = nullptr;
-  dds::TypeSupport packet_type{new hiveslam_msgs::msg::PacketPubSubType()};
-  dds::TypeSupport node_type{new hiveslam_msgs::msg::NodeInfoPubSubType()};
+  dds::TypeSupport packet_type{new CheckedType<hiveslam_msgs::msg::PacketPubSubType>()};
+  dds::TypeSupport node_type{new CheckedType<hiveslam_msgs::msg::NodeInfoPubSubType, noteDroppedAnnouncement>()};
   std::array<dds::Topic*, kTopicCount> topics{};
   dds::Topic* node_topic = nullptr;
   dds::DataWriter* node_writer = nullptr;
@@ -119,6 +91,7 @@ struct DdsTransport::Impl : public dds::DomainParticipantListener {
   std::thread peer_thread;
   std::condition_variable wake;
   std::atomic<uint16_t> self_node{0};  // set before any reader exists
+  std::atomic<uint64_t> self_incarnation{0};
 
   // The participants whose readers each writer has matched, for peerReads. Own lock: the
   // listener runs on Fast DDS threads, also inside create_datawriter.
@@ -182,8 +155,17 @@ struct DdsTransport::Impl : public dds::DomainParticipantListener {
       dds::SampleInfo info;
       while (r->take_next_sample(&m, &info) == ReturnCode_t::RETCODE_OK) {
         if (!info.valid_data) continue;
-        const PeerInfo p = fromIdl(m);
-        impl->peerSeen(p, info.sample_identity.writer_guid().guidPrefix);
+        std::string why;
+        const auto p = fromIdl(m, why);
+        // Two nodes with one id would make colliding keyframe and point ids.
+        if (p && p->node == impl->self_node.load() && p->incarnation != impl->self_incarnation.load())
+          why = "another process announces this node's id " + std::to_string(p->node) + " (give each node its own --id)";
+        if (!why.empty()) {
+          noteDroppedAnnouncement();
+          spdlog::warn("node {}: dropped an announcement: {}", impl->self_node.load(), why);
+          continue;
+        }
+        impl->peerSeen(*p, info.sample_identity.writer_guid().guidPrefix);
       }
     }
   } node_listener;
@@ -335,6 +317,7 @@ void DdsTransport::start(const PeerInfo& self, PeerHandler on_peer) {
     for (int i = 0; i < kTopicCount; ++i) d.writerFor(static_cast<Topic>(i));
   }
   d.self_node = self.node;
+  d.self_incarnation = self.incarnation;
   {
     std::lock_guard lock(d.mutex);
     d.self = self;

@@ -24,6 +24,7 @@
 
 #include "common/error.hpp"
 #include "common/thread_name.hpp"
+#include "communication/dds/checked_type.hpp"
 #include "communication/dds/participant_security.hpp"
 #include "sensor_msgs/msg/ImagePubSubTypes.h"
 
@@ -47,7 +48,7 @@ namespace {
 // A participant with one topic of the Image type, deleted with everything in it.
 struct ImageParticipant {
   dds::DomainParticipant* participant = nullptr;
-  dds::TypeSupport type{new sensor_msgs::msg::ImagePubSubType()};
+  dds::TypeSupport type{new CheckedType<sensor_msgs::msg::ImagePubSubType>()};
   dds::Topic* topic = nullptr;
 
   ImageParticipant(int domain, const std::string& ros_topic) {

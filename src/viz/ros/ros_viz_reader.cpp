@@ -3,6 +3,8 @@
 #include <fmt/format.h>
 
 #include "common/thread_name.hpp"
+#include "communication/dds/checked_type.hpp"
+#include "communication/dds/node_announcement.hpp"
 #include "communication/dds/topic_discovery.hpp"
 #include "geometry_msgs/msg/PoseStampedPubSubTypes.h"
 #include "hiveslam_msgs/msg/NodeInfoPubSubTypes.h"
@@ -46,9 +48,14 @@ struct RosVizReader::Impl {
 };
 
 RosVizReader::RosVizReader(LiveView& view, int domain) : impl_(std::make_unique<Impl>(domain)), view_(view) {
-  impl_->participant.reader(kNodesTopic, dds::TypeSupport(new hiveslam_msgs::msg::NodeInfoPubSubType()), 16,
+  impl_->participant.reader(kNodesTopic, dds::TypeSupport(new communication::CheckedType<hiveslam_msgs::msg::NodeInfoPubSubType, communication::noteDroppedAnnouncement>()), 16,
                             [this](dds::DataReader* r) {
                               takeAll<hiveslam_msgs::msg::NodeInfo>(r, [this](hiveslam_msgs::msg::NodeInfo& m) {
+                                std::string why;
+                                if (!communication::fromIdl(m, why)) {
+                                  communication::noteDroppedAnnouncement();
+                                  return;
+                                }
                                 ++received_;
                                 std::string text;
                                 {
@@ -95,7 +102,7 @@ void RosVizReader::follow(const std::string& node) {
     if (!impl_->followed.insert(node).second) return;
   }
   auto& p = impl_->participant;
-  p.reader(vizTopic(node, "status"), dds::TypeSupport(new std_msgs::msg::StringPubSubType()), 1, [this, node](dds::DataReader* r) {
+  p.reader(vizTopic(node, "status"), dds::TypeSupport(new communication::CheckedType<std_msgs::msg::StringPubSubType>()), 1, [this, node](dds::DataReader* r) {
     takeAll<std_msgs::msg::String>(r, [&](std_msgs::msg::String& m) {
       auto panel = nlohmann::json::parse(m.data(), nullptr, false);
       if (panel.is_discarded() || !panel.is_object()) {
@@ -106,7 +113,7 @@ void RosVizReader::follow(const std::string& node) {
       view_.setPanel(node, std::move(panel));
     });
   });
-  p.reader(vizTopic(node, "pose"), dds::TypeSupport(new geometry_msgs::msg::PoseStampedPubSubType()), 1,
+  p.reader(vizTopic(node, "pose"), dds::TypeSupport(new communication::CheckedType<geometry_msgs::msg::PoseStampedPubSubType>()), 1,
            [this, node](dds::DataReader* r) {
              takeAll<geometry_msgs::msg::PoseStamped>(r, [&](geometry_msgs::msg::PoseStamped& m) {
                ++received_;
@@ -118,7 +125,7 @@ void RosVizReader::follow(const std::string& node) {
                view_.setFrame(node, std::move(f), false);
              });
            });
-  p.reader(vizTopic(node, "path"), dds::TypeSupport(new nav_msgs::msg::PathPubSubType()), 1, [this, node](dds::DataReader* r) {
+  p.reader(vizTopic(node, "path"), dds::TypeSupport(new communication::CheckedType<nav_msgs::msg::PathPubSubType>()), 1, [this, node](dds::DataReader* r) {
     takeAll<nav_msgs::msg::Path>(r, [&](nav_msgs::msg::Path& m) {
       ++received_;
       view_.setPath(node, fromPath(m));
@@ -134,7 +141,7 @@ void RosVizReader::follow(const std::string& node) {
     }
     view_.setScene(node, std::move(scene));
   };
-  p.reader(vizTopic(node, "points"), dds::TypeSupport(new sensor_msgs::msg::PointCloud2PubSubType()), 1,
+  p.reader(vizTopic(node, "points"), dds::TypeSupport(new communication::CheckedType<sensor_msgs::msg::PointCloud2PubSubType>()), 1,
            [this, node, publish_scene](dds::DataReader* r) {
              takeAll<sensor_msgs::msg::PointCloud2>(r, [&](sensor_msgs::msg::PointCloud2& m) {
                MapScene s = fromPointCloud(m);
@@ -150,7 +157,7 @@ void RosVizReader::follow(const std::string& node) {
                publish_scene();
              });
            });
-  p.reader(vizTopic(node, "keyframe_markers"), dds::TypeSupport(new visualization_msgs::msg::MarkerArrayPubSubType()), 1,
+  p.reader(vizTopic(node, "keyframe_markers"), dds::TypeSupport(new communication::CheckedType<visualization_msgs::msg::MarkerArrayPubSubType>()), 1,
            [this, node, publish_scene](dds::DataReader* r) {
              takeAll<visualization_msgs::msg::MarkerArray>(r, [&](visualization_msgs::msg::MarkerArray& m) {
                ++received_;
