@@ -33,6 +33,7 @@ struct NodeCommandOptions {
   std::string task = "tr", name, dataset, out, config, times, expect, topic, calibration, ground_truth, atlas_out;
   int domain = 0, id = 0;
   bool realtime = false, no_loop_closing = false;
+  int repeat = 1;
   int wait_seconds = 20;
   bool no_ros = false;
   LiveViewOptions live;
@@ -139,6 +140,7 @@ void addNodeCommand(CLI::App& app) {
   cmd->add_option("--config", o->config, "Settings YAML");
   cmd->add_option("--times", o->times, "TR: times file for image folders and videos");
   cmd->add_flag("--realtime", o->realtime, "TR: feed frames at their timestamps");
+  cmd->add_option("--repeat", o->repeat, "TR: play the DATASET this many times in a row (a long run out of a short sequence)");
   cmd->add_flag("--no-loop-closing", o->no_loop_closing, "Switch loop closing off");
   addViewerOptions(cmd, o->live);
   cmd->add_flag("--no-ros", o->no_ros, "Do not publish the ROS 2 visualization topics (/hiveslam/<name>/...)");
@@ -162,6 +164,7 @@ void addNodeCommand(CLI::App& app) {
     run.config = o->config;
     run.times = o->times;
     run.realtime = o->realtime;
+    run.repeat = o->repeat;
     run.topic = o->topic;
     run.calibration = o->calibration;
     run.topic_domain = o->domain;

@@ -28,6 +28,7 @@
 #include "io/atlas_file.hpp"
 #include "io/vocabulary_file.hpp"
 #include "io/open_dataset.hpp"
+#include "io/repeated_source.hpp"
 #include "io/slam_settings_io.hpp"
 #include "io/trajectory_io.hpp"
 
@@ -126,7 +127,10 @@ RunSummary runSlam(const RunOptions& o) {
   if (o.dataset.empty() == o.topic.empty()) throw InputError("give a DATASET or a --topic (one of them)");
   if (o.live.viewer_port > 65535) throw InputError("viewer port must be 0-65535");
   if (o.topic.empty()) {
-    source = io::openDataset(o.dataset, dataset_options);
+    if (o.repeat == 1)
+      source = io::openDataset(o.dataset, dataset_options);
+    else
+      source = std::make_unique<io::RepeatedSource>([&] { return io::openDataset(o.dataset, dataset_options); }, o.repeat);
   } else {
     const std::string calibration = o.calibration.empty() ? o.config : o.calibration;
     if (calibration.empty()) throw InputError("an image topic carries no calibration: pass --calibration FILE");
@@ -373,6 +377,7 @@ void addRunCommand(CLI::App& app) {
   cmd->add_flag("--sequential", o->sequential, "Lockstep tracking and mapping on one thread (deterministic)");
   cmd->add_flag("--realtime", o->realtime, "Feed frames at their timestamps; tracking never waits for mapping");
   cmd->add_option("--max-frames", o->max_frames, "Stop after this many frames");
+  cmd->add_option("--repeat", o->repeat, "Play the DATASET this many times in a row (a long run out of a short sequence)");
   cmd->add_flag("--no-loop-closing", o->no_loop_closing, "Switch loop closing and map merging off");
   cmd->add_option("--atlas-in", o->atlas_in, "Load the maps of a saved atlas before the run");
   cmd->add_option("--atlas-out", o->atlas_out, "Save the maps to an atlas file after the run");

@@ -22,6 +22,7 @@ struct RunOptions {
   std::string atlas_in, atlas_out;  // load maps before the run / save them after it
   bool localization = false;         // track against atlas_in without mapping
   int max_frames = 0;
+  int repeat = 1;  // the dataset played this many times in a row (io/repeated_source.hpp)
   // Instead of a dataset: a ROS 2 sensor_msgs/msg/Image topic on DDS domain topic_domain, with
   // the calibration from a file (settings YAML, sensor.yaml or calib.txt).
   std::string topic, calibration;

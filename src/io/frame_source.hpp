@@ -29,6 +29,9 @@ class FrameSource {
   virtual const std::optional<Trajectory>& groundTruth() const = 0;
   // One line: format, location, frame count.
   virtual std::string describe() const = 0;
+  // When the format lists every stamp up front: from the first frame to one mean frame interval
+  // past the last, the time a replay of the whole sequence takes (io/repeated_source.hpp).
+  virtual std::optional<double> period() const { return std::nullopt; }
 };
 
 }  // namespace hiveslam::io

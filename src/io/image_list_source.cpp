@@ -40,6 +40,11 @@ std::optional<Frame> ImageListSource::next() {
   return frame;
 }
 
+std::optional<double> ImageListSource::period() const {
+  const double span = entries_.back().timestamp - entries_.front().timestamp;
+  return entries_.size() < 2 ? std::nullopt : std::optional<double>(span * static_cast<double>(entries_.size()) / static_cast<double>(entries_.size() - 1));
+}
+
 std::string ImageListSource::describe() const {
   return fmt::format("{} {} ({} frames, {}x{} {}{})", format_, root_.string(), entries_.size(),
                      camera_.camera->width(), camera_.camera->height(), camera_.camera->type(),

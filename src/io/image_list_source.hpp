@@ -24,6 +24,7 @@ class ImageListSource final : public FrameSource {
   const CameraSettings& camera() const override { return camera_; }
   const std::optional<Trajectory>& groundTruth() const override { return ground_truth_; }
   std::string describe() const override;
+  std::optional<double> period() const override;
 
  private:
   std::string format_;

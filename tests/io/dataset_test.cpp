@@ -8,6 +8,7 @@
 
 #include "common/error.hpp"
 #include "io/open_dataset.hpp"
+#include "io/repeated_source.hpp"
 #include "io/trajectory_io.hpp"
 #include "synth/sequence.hpp"
 #include "temp_dir.hpp"
@@ -60,6 +61,34 @@ TEST(EurocDataset, ReadsASyntheticSequenceWithGroundTruth) {
   EXPECT_EQ(n, 6);
   // The mav0 folder itself is accepted too.
   EXPECT_EQ(openDataset(dir / "mav0")->size(), 6u);
+}
+
+// --repeat: the passes follow each other by the sequence's period (6 frames at 20 Hz: 0.3 s),
+// as one stream with increasing stamps and indices, and the ground truth repeats with them.
+TEST(RepeatedSource, PlaysTheSequenceAgainAfterItsPeriod) {
+  testing::TempDir dir;
+  synth::writeSequence(tiny(), dir.path());
+  RepeatedSource source([&] { return openDataset(dir.path()); }, 3);
+  ASSERT_EQ(source.size(), 18u);
+  ASSERT_TRUE(source.groundTruth());
+  ASSERT_EQ(source.groundTruth()->size(), 18u);
+  std::vector<double> stamps;
+  while (auto f = source.next()) {
+    EXPECT_EQ(f->index, stamps.size());
+    EXPECT_NEAR(f->timestamp, source.groundTruth()->stamps[stamps.size()], 1e-9);
+    stamps.push_back(f->timestamp);
+  }
+  ASSERT_EQ(stamps.size(), 18u);
+  EXPECT_NEAR(stamps[6] - stamps[0], 0.3, 1e-9);
+  EXPECT_NEAR(stamps[12] - stamps[6], 0.3, 1e-9);
+  for (size_t i = 1; i < stamps.size(); ++i) EXPECT_NEAR(stamps[i] - stamps[i - 1], 0.05, 1e-9) << i;
+  EXPECT_TRUE(source.groundTruth()->poses[7].isApprox(source.groundTruth()->poses[1]));
+}
+
+TEST(RepeatedSource, NeedsOnePassAtLeast) {
+  testing::TempDir dir;
+  synth::writeSequence(tiny(), dir.path());
+  EXPECT_THROW(RepeatedSource([&] { return openDataset(dir.path()); }, 0), InputError);
 }
 
 TEST(EurocDataset, ASettingsFileWithoutCameraKeepsTheDatasetCalibration) {
