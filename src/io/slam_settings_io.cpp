@@ -82,6 +82,7 @@ KeyTable slamKeys(core::SlamSettings& s) {
       {"remeasure", set(s.remeasure)},
       {"remeasure_image_budget_mb", set(s.remeasure_image_budget_mb)},
       {"refine_frames", set(s.refine_frames)},
+      {"refine_frames_window", set(s.refine_frames_window)},
       {"vocabulary", set(s.vocabulary)},
       {"seed", set(s.seed)},
   };

@@ -130,6 +130,10 @@ struct SlamSettings {
   // its reference keyframe as it was when tracked, and keeps the map's error of that moment.
   // Costs about 24 bytes per match kept (some 6 KB per frame).
   bool refine_frames = true;
+  // Matches are kept for the last this many frames only (0: every frame): a long run's memory
+  // would grow by them without end (a 3-node soak's TR by 12.5 MB a minute at 20 Hz, figure8's
+  // 10 KB a frame). Older frames stay as tracked, relative to their reference keyframe.
+  int refine_frames_window = 3000;
   // Determinism: RANSAC seed
   uint64_t seed = 1;
 };

@@ -343,6 +343,9 @@ const FrameRecord& SlamSystem::process(const cv::Mat& gray, double timestamp) {
   // Lost: this frame failed where the last one tracked.
   if (events_ && !r.tracked && !records_.empty() && records_.back().tracked) events_->trackingLost();
   records_.push_back(std::move(r));
+  if (const auto window = static_cast<size_t>(std::max(settings_.refine_frames_window, 0));
+      window > 0 && records_.size() > window)
+    std::vector<FrameObservation>().swap(records_[records_.size() - 1 - window].observations);
   if (frame_listener_) frame_listener_(records_.back(), out.T_cw, keypoints, gray);
   return records_.back();
 }
