@@ -7,7 +7,28 @@ void KeyframeImageStore::keep(Id keyframe, const cv::Mat& gray) {
   std::lock_guard lock(mutex_);
   if (bytes_ + size > budget_ || images_.count(keyframe)) return;
   images_.emplace(keyframe, gray.clone());
+  order_.push_back(keyframe);
   bytes_ += size;
+}
+
+size_t KeyframeImageStore::retain(const std::function<bool(Id)>& live, size_t recent) {
+  std::lock_guard lock(mutex_);
+  size_t dropped = 0;
+  std::deque<Id> kept;
+  for (size_t i = 0; i < order_.size(); ++i) {
+    const Id id = order_[i];
+    if (i + recent >= order_.size() || live(id)) {
+      kept.push_back(id);
+      continue;
+    }
+    const auto it = images_.find(id);
+    bytes_ -= it->second.total() * it->second.elemSize();
+    images_.erase(it);
+    pyramids_.remove_if([id](const auto& p) { return p.first == id; });
+    ++dropped;
+  }
+  order_ = std::move(kept);
+  return dropped;
 }
 
 bool KeyframeImageStore::empty() const {

@@ -8,6 +8,8 @@
 // latest few dozen kept (levels 1-7 hold 2.1 times level 0: all of sweep's together were 95 MB
 // more at the pass), and released after it. Past the byte budget no more images are kept: those
 // keyframes' observations stay as detected.
+#include <deque>
+#include <functional>
 #include <list>
 #include <memory>
 #include <mutex>
@@ -30,11 +32,16 @@ class KeyframeImageStore {
   std::shared_ptr<const features::ImagePyramid> pyramid(Id keyframe, int levels, double scale_factor);
   void releasePyramids();
   size_t pyramidsBuilt() const;
+  // Drops the images of keyframes `live` says are gone (culled: no pass will measure their
+  // observations again), all but the `recent` last kept, whose keyframes may still wait for local
+  // mapping to enter their map. Returns how many were dropped.
+  size_t retain(const std::function<bool(Id)>& live, size_t recent);
 
  private:
   mutable std::mutex mutex_;
   size_t budget_, cached_, bytes_ = 0, built_ = 0;
   std::unordered_map<Id, cv::Mat> images_;
+  std::deque<Id> order_;  // of keeping
   // Most recently used first.
   std::list<std::pair<Id, std::shared_ptr<const features::ImagePyramid>>> pyramids_;
 };

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <chrono>
 #include <thread>
+#include <unordered_set>
 
 #include "common/thread_name.hpp"
 #include "core/mapping/keyframe_insertion.hpp"
@@ -313,7 +314,10 @@ const FrameRecord& SlamSystem::process(const cv::Mat& gray, double timestamp) {
     r.observations = std::move(out.observations);
   }
   if (out.new_keyframe) {
-    if (settings_.remeasure) images_.keep(out.new_keyframe->id, gray);
+    if (settings_.remeasure) {
+      images_.keep(out.new_keyframe->id, gray);
+      if (++images_kept_ % 32 == 0) dropCulledKeyframeImages();
+    }
     // Mapping may have gone to another node while this frame was tracked. Decided again under
     // the lock that counts queued keyframes, a newcomer's snapshot (which waits for
     // mappingIdle) either waits for this keyframe or the keyframe goes to the new mapper.
@@ -348,6 +352,19 @@ const FrameRecord& SlamSystem::process(const cv::Mat& gray, double timestamp) {
     std::vector<FrameObservation>().swap(records_[records_.size() - 1 - window].observations);
   if (frame_listener_) frame_listener_(records_.back(), out.T_cw, keypoints, gray);
   return records_.back();
+}
+
+void SlamSystem::dropCulledKeyframeImages() {
+  // The live keyframes first, one map lock at a time: the store's own lock is taken under a
+  // map's by the re-measurement pass, so never the other way round.
+  std::unordered_set<Id> live;
+  for (const auto& m : liveMaps()) {
+    std::lock_guard lock(m->mutex);
+    for (const auto& [id, kf] : m->keyframes) live.insert(id);
+  }
+  // The last few kept may still wait in local mapping's queue, outside their map.
+  constexpr size_t kQueued = 8;
+  images_.retain([&](Id id) { return live.count(id) > 0; }, kQueued);
 }
 
 Eigen::Isometry3d SlamSystem::poseOf(const FrameRecord& r) const {

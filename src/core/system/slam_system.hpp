@@ -169,6 +169,11 @@ class SlamSystem {
   std::atomic<int> loop_jobs_pending_{0};
   std::atomic<bool> final_ba_done_{false};
   KeyframeImageStore images_;
+  int images_kept_ = 0;  // tracking thread
+  // Every 32 keyframes: the images of culled keyframes go. A long run at one place culls about as
+  // many keyframes as it makes (a 30-minute soak of figure8 ended with 86), and each culled one's
+  // image (361 KB at 752x480) stayed until the 512 MB budget was spent.
+  void dropCulledKeyframeImages();
   // The image of the current initialization attempt's first frame (tracking thread only): a new
   // map's first keyframe is made of it, frames after it was seen.
   cv::Mat initialization_image_;
