@@ -41,10 +41,9 @@ SlamSystem::SlamSystem(const SlamSettings& settings, std::shared_ptr<const camer
     mapper_.setDatabase(&database_);
     if (settings_.relocalize_in_every_map)
       tracker_.setMapFinder([this](const Map* place_map) -> std::shared_ptr<Map> {
-        std::lock_guard lock(atlas_mutex_);
-        for (const auto& m : maps_)
-          if (m.get() == place_map) return m->merged_into.load() ? nullptr : m;
-        return nullptr;
+        // The atlas never lets a map go, so the database's pointer is still a map of maps_.
+        auto map = findMap(place_map->id);
+        return map && !map->merged_into.load() ? map : nullptr;
       });
   }
   hosting_loop_closing_ = settings_.loop_closing;

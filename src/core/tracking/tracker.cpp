@@ -31,7 +31,9 @@ TrackingOutput Tracker::track(Frame frame, bool mapping_idle) {
   if (state_ == TrackingState::NotInitialized) {
     // Before a new map: the frame may show a place a map already holds (the one just lost
     // included), and tracking goes on there.
-    ok = !localization_only_ && map_finder_ && relocalizeInKnownMap(current, queryPlaces(current.frame), nullptr, lock);
+    // (No map yet, as at the start of a run: no bag of words to compute.)
+    ok = !localization_only_ && map_finder_ && database_ && database_->size() > 0 &&
+         relocalizeInKnownMap(current, queryPlaces(current.frame), nullptr, lock);
     if (!ok) {
       if (initialize(current, out)) {
         state_ = TrackingState::Ok;
