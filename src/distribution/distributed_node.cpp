@@ -281,6 +281,8 @@ void DistributedNode::departed(const PeerInfo& peer) {
   }
   applyPlan();
   transport_.announce(self());
+  // A tracking node that left before handing its map over hands nothing over.
+  if (peer.task == Task::Tracking) releaseHeldUpdates(core::kNoId, nullptr);
   // LC whose mapping node left: TR maps again, and is its gateway now.
   if (options_.task == Task::LoopClosing && peer.task == Task::Mapping) resendGlobalsToTracking();
   // TR, the gateway now that its LM left, and an LC: the keyframes LM had mapped but not yet

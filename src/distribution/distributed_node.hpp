@@ -118,6 +118,14 @@ class DistributedNode final : public core::SystemEvents {
   void dropPendingGlobals(const communication::PeerInfo& peer);
   void applyPlan();
   void onGlobal(std::vector<MapRecord>&& batches, communication::Topic topic, uint16_t source);
+  // The gateway: LC's update applied, then this node's state of the map relayed (LmMap).
+  void applyLoopClosingUpdate(const std::vector<MapRecord>& batches);
+  // The gateway: LC's update of a map that a tracking node back from a partition has yet to
+  // hand over, held until it has (true), then applied if it was made from that map.
+  bool holdForAdoption(std::vector<MapRecord>& batches);
+  // Held updates applied: those of `map` (all maps if kNoId); with `adopted`, only one that
+  // covers it (StateIntegrator::covers), the others dropped as older than the adopted map.
+  void releaseHeldUpdates(core::Id map, const std::vector<MapRecord>* adopted);
   void onControl(const communication::Message& m, communication::Topic topic);
   // The gateway's part of the end of a run. Returns whether the LC (if any) answered.
   bool finishAsGateway();
@@ -216,6 +224,8 @@ class DistributedNode final : public core::SystemEvents {
   // LM, LC: tracking nodes back from a partition, by node, and the maps already taken whole
   // from them (the first global map of each: StateIntegrator::adoptGlobal). Guarded by mutex_.
   std::map<uint16_t, std::set<core::Id>> adopt_from_;
+  // The gateway: LC's latest update of each map held by holdForAdoption. Guarded by mutex_.
+  std::map<core::Id, std::vector<MapRecord>> held_updates_;
   // Peers that left and have not come back (StateIntegrator::setDeparted). Its own lock, taken
   // last: the integrator asks with a map's mutex held.
   mutable std::mutex departed_mutex_;

@@ -107,6 +107,9 @@ void DistributedNode::pushRemeasurements(const core::Remeasurements& r, Topic to
 }
 
 bool DistributedNode::finishAsGateway() {
+  // No hand-over is waited for past the end; applied on the map handler's thread, in order.
+  handler_->afterIncoming([this] { releaseHeldUpdates(core::kNoId, nullptr); });
+  while (!handler_->idle()) std::this_thread::sleep_for(std::chrono::milliseconds(5));
   slam_.drain();
   bool answered = true;
   if (plan().keyframes_to_lc) {

@@ -56,18 +56,7 @@ void DistributedNode::onGlobal(std::vector<MapRecord>&& batches, Topic topic, ui
     return;
   }
   if (topic == Topic::LcMap) {
-    // The gateway applies LC's update, then relays its own full state of the map: LC's update
-    // plus what LM made meanwhile, in one coordinate frame.
-    integrator_.applyGlobal(batches, false);
-    std::vector<core::Id> merged;
-    for (const auto& b : batches) merged.insert(merged.end(), b.merged_maps.begin(), b.merged_maps.end());
-    auto map = slam_.findMap(map_id);
-    {
-      std::lock_guard lock(mutex_);
-      synced_[map_id] = std::max(synced_[map_id], epoch);
-      if (map) handler_->sendGlobal(map, epoch, Topic::LmMap, merged);
-    }
-    releaseHeld(map_id);
+    if (!holdForAdoption(batches)) applyLoopClosingUpdate(batches);
     return;
   }
   bool ignore = false, newer = false;
@@ -116,6 +105,64 @@ void DistributedNode::onGlobal(std::vector<MapRecord>&& batches, Topic topic, ui
   }
 }
 
+void DistributedNode::applyLoopClosingUpdate(const std::vector<MapRecord>& batches) {
+  // The gateway applies LC's update, then relays its own full state of the map: LC's update
+  // plus what LM made meanwhile, in one coordinate frame.
+  const core::Id map_id = batches.front().map;
+  const uint64_t epoch = batches.front().epoch;
+  integrator_.applyGlobal(batches, false);
+  std::vector<core::Id> merged;
+  for (const auto& b : batches) merged.insert(merged.end(), b.merged_maps.begin(), b.merged_maps.end());
+  auto map = slam_.findMap(map_id);
+  {
+    std::lock_guard lock(mutex_);
+    synced_[map_id] = std::max(synced_[map_id], epoch);
+    if (map) handler_->sendGlobal(map, epoch, Topic::LmMap, merged);
+  }
+  releaseHeld(map_id);
+}
+
+bool DistributedNode::holdForAdoption(std::vector<MapRecord>& batches) {
+  const core::Id map_id = batches.front().map;
+  std::lock_guard lock(mutex_);
+  // LC may take the returning tracking node's map before this node does (each gets its own
+  // copy). Applied to this node's map, which still lacks what TR mapped alone, the relay that
+  // follows lists none of those keyframes, and TR erased them as culled here: it ended a 30 s
+  // cut from both peers with 19 of the 85 keyframes LM and LC held.
+  const bool awaited = std::any_of(adopt_from_.begin(), adopt_from_.end(), [&](const auto& a) {
+    return peers_.count(a.first) && !a.second.count(map_id);
+  });
+  if (!awaited) return false;
+  auto& held = held_updates_[map_id];
+  if (!held.empty() && held.front().epoch > batches.front().epoch) return true;  // a newer one waits
+  spdlog::info("node {}: LC's update of map {} (epoch {}) waits for the map of a node back from a partition",
+               options_.id, map_id, batches.front().epoch);
+  held = std::move(batches);
+  return true;
+}
+
+void DistributedNode::releaseHeldUpdates(core::Id map, const std::vector<MapRecord>* adopted) {
+  std::vector<std::vector<MapRecord>> ready;
+  {
+    std::lock_guard lock(mutex_);
+    for (auto it = held_updates_.begin(); it != held_updates_.end();) {
+      if (map != core::kNoId && it->first != map) {
+        ++it;
+        continue;
+      }
+      if (!adopted || StateIntegrator::covers(it->second, *adopted)) {
+        ready.push_back(std::move(it->second));
+      } else {
+        ++globals_ignored_;
+        spdlog::info("node {}: LC's update of map {} (epoch {}) dropped: made before LC took the map back from the "
+                     "partition", options_.id, it->first, it->second.front().epoch);
+      }
+      it = held_updates_.erase(it);
+    }
+  }
+  for (const auto& batches : ready) applyLoopClosingUpdate(batches);
+}
+
 void DistributedNode::adoptWhole(const std::vector<MapRecord>& batches, uint16_t source, const char* why) {
   const core::Id map_id = batches.front().map;
   const uint64_t epoch = batches.front().epoch;
@@ -128,6 +175,7 @@ void DistributedNode::adoptWhole(const std::vector<MapRecord>& batches, uint16_t
   }
   spdlog::info("node {}: map {} taken whole from node {}, {} (epoch {})", options_.id, map_id, source, why, epoch);
   releaseHeld(map_id);
+  releaseHeldUpdates(map_id, &batches);
 }
 
 uint64_t DistributedNode::knownEpoch(core::Id map) const {

@@ -407,6 +407,18 @@ void StateIntegrator::applyAhead(const MapRecord& m) {
     if (!kf->bad) kf->updateConnections();
 }
 
+bool StateIntegrator::covers(const std::vector<MapRecord>& update, const std::vector<MapRecord>& snapshot) {
+  std::vector<Id> ids;
+  for (const auto& b : update)
+    for (const auto& k : b.keyframes) ids.push_back(k.id);
+  const std::unordered_set<Id> held(ids.begin(), ids.end());
+  const auto newest = newestByNode(ids);
+  for (const auto& b : snapshot)
+    for (const auto& k : b.keyframes)
+      if (olderThanSnapshot(k.id, newest) && !held.count(k.id)) return false;
+  return true;
+}
+
 void StateIntegrator::adoptGlobal(const std::vector<MapRecord>& batches) {
   if (batches.empty()) return;
   {

@@ -71,6 +71,10 @@ class StateIntegrator {
   // forgotten: the map of a tracking node back from a partition. It mapped on alone while this
   // node's labels went on without it, so one label can stand for two frames on the two sides.
   void adoptGlobal(const std::vector<MapRecord>& batches);
+  // Whether a global update holds every keyframe of `snapshot` that its sender knew of (those
+  // older than its own newest keyframe of the same node): an update made from that snapshot or
+  // later, not from a map that had not yet taken it.
+  static bool covers(const std::vector<MapRecord>& update, const std::vector<MapRecord>& snapshot);
   uint64_t stalePointsCarried() const { return stale_points_carried_; }
   // Whether a node has left the network (and not come back). An authoritative map spares the
   // points its sender may not have heard of yet; a node that left sends none any more, so its

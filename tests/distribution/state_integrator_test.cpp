@@ -628,5 +628,30 @@ TEST_F(EpochLabels, AnAuthoritativeSnapshotOfOneMapLeavesAnotherMapsRecords) {
   EXPECT_EQ(observer_.digest().keyframes.count(kOtherKeyframe), 0u);
 }
 
+// At the heal of a partition, LC may take the returning tracking node's map and send an
+// update before the gateway has taken it. The gateway holds that update until it has, and
+// applies it only if it was made from that map: one that lacks keyframes of the map older than
+// its own newest was made from the map as it was before.
+TEST(CoversSnapshot, AnUpdateCoversASnapshotOnlyIfItHoldsEverythingOlderThanItsNewest) {
+  const auto records = [](std::vector<Id> ids) {
+    MapRecord m;
+    m.kind = MapRecord::Kind::Global;
+    for (Id id : ids) {
+      KeyFrameRecord k;
+      k.id = id;
+      m.keyframes.push_back(k);
+    }
+    return std::vector<MapRecord>{m};
+  };
+  const Id a = Id{1} << 48;  // keyframes of node 1
+  const Id b = Id{2} << 48;  // of node 2
+  const auto snapshot = records({a + 1, a + 2, a + 3, a + 4, b + 1});
+  EXPECT_TRUE(StateIntegrator::covers(records({a + 1, a + 2, a + 3, a + 4, b + 1}), snapshot));
+  EXPECT_TRUE(StateIntegrator::covers(records({a + 1, a + 2, a + 3, b + 1}), snapshot)) << "a + 4 is newer than it knew";
+  EXPECT_TRUE(StateIntegrator::covers(records({a + 1, a + 2, a + 3, a + 4, a + 5, b + 1}), snapshot));
+  EXPECT_FALSE(StateIntegrator::covers(records({a + 1, a + 4, b + 1}), snapshot)) << "made before a + 2 and a + 3 were in";
+  EXPECT_FALSE(StateIntegrator::covers(records({a + 1, a + 2, a + 3, a + 4, b + 2}), snapshot)) << "b + 1 missing";
+}
+
 }  // namespace
 }  // namespace hiveslam::distribution
