@@ -25,7 +25,8 @@ nlohmann::json DistributedNode::report(double seconds) const {
   for (const auto& [name, t] : transport_.traffic()) {
     topics[name] = {{"bytes_out", t.bytes_out},       {"bytes_in", t.bytes_in},
                     {"messages_out", t.messages_out}, {"messages_in", t.messages_in},
-                    {"writes_failed", t.writes_failed}, {"messages_lost", t.messages_lost}};
+                    {"writes_failed", t.writes_failed}, {"messages_lost", t.messages_lost},
+                    {"messages_refused", t.messages_refused}};
     bytes_out += t.bytes_out;
     bytes_in += t.bytes_in;
     msgs_out += t.messages_out;

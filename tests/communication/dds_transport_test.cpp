@@ -10,6 +10,7 @@
 #include <fastdds/dds/publisher/DataWriter.hpp>
 #include <fastdds/dds/publisher/Publisher.hpp>
 #include <fastdds/dds/publisher/qos/DataWriterQos.hpp>
+#include <fastdds/dds/core/status/PublicationMatchedStatus.hpp>
 #include <fastdds/dds/topic/Topic.hpp>
 #include <fastdds/dds/topic/TopicDataType.hpp>
 #include <fastdds/dds/topic/TypeSupport.hpp>
@@ -18,11 +19,13 @@
 #include <cstring>
 #include <condition_variable>
 #include <mutex>
+#include <set>
 #include <thread>
 #include <vector>
 
 #include "communication/dds/node_announcement.hpp"
 #include "hiveslam_msgs/msg/NodeInfoPubSubTypes.h"
+#include "hiveslam_msgs/msg/PacketPubSubTypes.h"
 #include "eventually.hpp"
 
 namespace hiveslam::communication {
@@ -127,6 +130,37 @@ class RawBytes : public eprosima::fastdds::dds::TopicDataType {
   bool getKey(void*, eprosima::fastrtps::rtps::InstanceHandle_t*, bool) override { return false; }
 };
 
+// A participant of no hiveslam node on the tests' domain, with one reliable, transient-local
+// writer of `type` on `topic_name`: what anyone on the network can write.
+class RawWriter {
+ public:
+  RawWriter(eprosima::fastdds::dds::TopicDataType* type, const std::string& topic_name) : type_(type) {
+    namespace dds = eprosima::fastdds::dds;
+    participant_ = dds::DomainParticipantFactory::get_instance()->create_participant(232, dds::PARTICIPANT_QOS_DEFAULT);
+    if (!participant_) return;
+    type_.register_type(participant_);
+    dds::Topic* topic = participant_->create_topic(topic_name, type_.get_type_name(), dds::TOPIC_QOS_DEFAULT);
+    dds::Publisher* publisher = participant_->create_publisher(dds::PUBLISHER_QOS_DEFAULT);
+    dds::DataWriterQos wq = dds::DATAWRITER_QOS_DEFAULT;
+    wq.reliability().kind = dds::RELIABLE_RELIABILITY_QOS;
+    wq.durability().kind = dds::TRANSIENT_LOCAL_DURABILITY_QOS;
+    writer_ = publisher->create_datawriter(topic, wq);
+  }
+  ~RawWriter() {
+    if (!participant_) return;
+    participant_->delete_contained_entities();
+    eprosima::fastdds::dds::DomainParticipantFactory::get_instance()->delete_participant(participant_);
+  }
+  RawWriter(const RawWriter&) = delete;
+  RawWriter& operator=(const RawWriter&) = delete;
+  eprosima::fastdds::dds::DataWriter* writer() const { return writer_; }
+
+ private:
+  eprosima::fastdds::dds::TypeSupport type_;
+  eprosima::fastdds::dds::DomainParticipant* participant_ = nullptr;
+  eprosima::fastdds::dds::DataWriter* writer_ = nullptr;
+};
+
 // An announcement whose `leaving` byte is 2: Fast CDR throws on such a bool, and the generated
 // code let it out of take_next_sample, so one such sample ended every node on the domain
 // (std::terminate on the listener thread; fuzz/announcement_fuzzer.cpp found it). It is dropped
@@ -162,28 +196,19 @@ TEST(DdsTransport, AnAnnouncementThatCannotBeReadIsDroppedAndTheNodeGoesOn) {
     if (p.node == 2 && present) heard_b = true;
   });
   const int dropped_before = droppedAnnouncements();
-  auto* factory = dds::DomainParticipantFactory::get_instance();
-  dds::DomainParticipant* raw = factory->create_participant(232, dds::PARTICIPANT_QOS_DEFAULT);
-  ASSERT_NE(raw, nullptr);
-  dds::TypeSupport type(new RawBytes(node_info.getName()));
-  type.register_type(raw);
-  dds::Topic* topic = raw->create_topic("rt/hiveslam/nodes", type.get_type_name(), dds::TOPIC_QOS_DEFAULT);
-  dds::Publisher* publisher = raw->create_publisher(dds::PUBLISHER_QOS_DEFAULT);
-  dds::DataWriterQos wq = dds::DATAWRITER_QOS_DEFAULT;
-  wq.reliability().kind = dds::RELIABLE_RELIABILITY_QOS;
-  wq.durability().kind = dds::TRANSIENT_LOCAL_DURABILITY_QOS;
-  dds::DataWriter* writer = publisher->create_datawriter(topic, wq);
-  ASSERT_NE(writer, nullptr);
-  EXPECT_TRUE(testing::eventually(
-      [&] {
-        writer->write(&bytes);
-        return droppedAnnouncements() > dropped_before;
-      },
-      std::chrono::seconds(10)));
-  b.start(self_b, [](const PeerInfo&, bool) {});
-  EXPECT_TRUE(testing::eventually([&] { return heard_b.load(); }, std::chrono::seconds(10)));
-  raw->delete_contained_entities();
-  factory->delete_participant(raw);
+  {
+    RawWriter raw(new RawBytes(node_info.getName()), "rt/hiveslam/nodes");
+    dds::DataWriter* writer = raw.writer();
+    ASSERT_NE(writer, nullptr);
+    EXPECT_TRUE(testing::eventually(
+        [&] {
+          writer->write(&bytes);
+          return droppedAnnouncements() > dropped_before;
+        },
+        std::chrono::seconds(10)));
+    b.start(self_b, [](const PeerInfo&, bool) {});
+    EXPECT_TRUE(testing::eventually([&] { return heard_b.load(); }, std::chrono::seconds(10)));
+  }
   b.stop();
   a.stop();
 }
@@ -264,6 +289,169 @@ TEST(DdsTransport, AStopThatHangsInsideFastDdsIsLeftBehind) {
   }
   released.notify_all();
   EXPECT_TRUE(testing::eventually([] { return DdsTransport::teardownsRunning() == 0; }, std::chrono::seconds(10)));
+}
+
+uint64_t refusedOn(const DdsTransport& t, Topic topic) {
+  const auto r = t.traffic();
+  auto it = r.find(topicName(topic));
+  return it == r.end() ? 0 : it->second.messages_refused;
+}
+
+// A packet names its source node. One that comes from the participant of another node (a
+// process writing into a node's stream under its id) is refused and counted; the node's own
+// packets and those of the other node under its own id still go through.
+TEST(DdsTransport, APacketNamingAnotherNodeThanItsSenderIsRefused) {
+  DdsTransport a({232}), b({232}), c({232});
+  PeerInfo sa, sb, sc;
+  sa.node = 1;
+  sb.node = 2;
+  sc.node = 3;
+  std::mutex mutex;
+  std::set<uint16_t> peers;
+  std::vector<uint16_t> got;
+  a.start(sa, [&](const PeerInfo& p, bool present) {
+    std::lock_guard lock(mutex);
+    if (present) peers.insert(p.node);
+  });
+  b.start(sb, [](const PeerInfo&, bool) {});
+  c.start(sc, [](const PeerInfo&, bool) {});
+  a.subscribe(Topic::TrKeyframes, [&](Message&& m) {
+    std::lock_guard lock(mutex);
+    got.push_back(m.source);
+  });
+  const auto count = [&] {
+    std::lock_guard lock(mutex);
+    return got.size();
+  };
+  ASSERT_TRUE(testing::eventually(
+      [&] {
+        std::lock_guard lock(mutex);
+        return peers.count(2) && peers.count(3);
+      },
+      std::chrono::seconds(10)));
+  // A packet may go out before the reader matched (DDS discovery): sent until one is in.
+  const auto packet = [](uint16_t source) {
+    Message m;
+    m.source = source;
+    return m;
+  };
+  ASSERT_TRUE(testing::eventually([&] { return b.peerReads(Topic::TrKeyframes, 1) && c.peerReads(Topic::TrKeyframes, 1); },
+                                  std::chrono::seconds(10)));
+  b.publish(Topic::TrKeyframes, packet(2));
+  ASSERT_TRUE(testing::eventually([&] { return count() == 1; }, std::chrono::seconds(10)));
+  c.publish(Topic::TrKeyframes, packet(2));  // node 3 names node 2
+  c.publish(Topic::TrKeyframes, packet(3));
+  ASSERT_TRUE(testing::eventually([&] { return count() == 2; }, std::chrono::seconds(10)));
+  EXPECT_EQ(refusedOn(a, Topic::TrKeyframes), 1u);
+  {
+    std::lock_guard lock(mutex);
+    EXPECT_EQ(got, (std::vector<uint16_t>{2, 3}));
+  }
+  c.stop();
+  b.stop();
+  a.stop();
+}
+
+// Two processes announce one node id (two devices started with the same --id): the one
+// started later is the node, and the other's announcements and packets are refused and
+// counted. (A restart looks the same to its peers until the old process's lease ends.)
+TEST(DdsTransport, OfTwoProcessesWithOneNodeIdTheLaterIsTheNode) {
+  DdsTransport a({232}), older({232}), newer({232});
+  PeerInfo sa, so, sn;
+  sa.node = 1;
+  so.node = sn.node = 2;
+  so.incarnation = 10;
+  sn.incarnation = 20;
+  std::mutex mutex;
+  std::vector<uint64_t> incarnations;  // of node 2, as node 1 hears it
+  std::vector<uint16_t> got;
+  a.start(sa, [&](const PeerInfo& p, bool present) {
+    std::lock_guard lock(mutex);
+    if (present && p.node == 2) incarnations.push_back(p.incarnation);
+  });
+  a.subscribe(Topic::TrKeyframes, [&](Message&& m) {
+    std::lock_guard lock(mutex);
+    got.push_back(m.target);
+  });
+  const int dropped_before = droppedAnnouncements();
+  older.start(so, [](const PeerInfo&, bool) {});
+  newer.start(sn, [](const PeerInfo&, bool) {});
+  ASSERT_TRUE(testing::eventually([&] { return droppedAnnouncements() > dropped_before + 1; }, std::chrono::seconds(10)))
+      << "the older process's announcements still heard";
+  ASSERT_TRUE(testing::eventually([&] { return older.peerReads(Topic::TrKeyframes, 1) && newer.peerReads(Topic::TrKeyframes, 1); },
+                                  std::chrono::seconds(10)));
+  Message from_older, from_newer;
+  from_older.source = from_newer.source = 2;
+  from_older.target = 10;
+  from_newer.target = 20;
+  older.publish(Topic::TrKeyframes, std::move(from_older));
+  newer.publish(Topic::TrKeyframes, std::move(from_newer));
+  ASSERT_TRUE(testing::eventually([&] { return refusedOn(a, Topic::TrKeyframes) == 1; }, std::chrono::seconds(10)));
+  ASSERT_TRUE(testing::eventually(
+      [&] {
+        std::lock_guard lock(mutex);
+        return !got.empty();
+      },
+      std::chrono::seconds(10)));
+  {
+    std::lock_guard lock(mutex);
+    EXPECT_EQ(got, std::vector<uint16_t>{20});
+    ASSERT_FALSE(incarnations.empty());
+    EXPECT_EQ(incarnations.back(), 20u);
+  }
+  newer.stop();
+  older.stop();
+  a.stop();
+}
+
+// A packet whose sequence number does not go past its writer's last one (the same bytes sent
+// again, or an older packet after a newer one) is refused and counted: it would bring back a
+// keyframe or a map its writer has moved past.
+TEST(DdsTransport, APacketReplayedOrOutOfOrderIsRefused) {
+  namespace dds = eprosima::fastdds::dds;
+  DdsTransport a({232});
+  PeerInfo sa;
+  sa.node = 1;
+  std::mutex mutex;
+  std::vector<uint64_t> got;
+  a.start(sa, [](const PeerInfo&, bool) {});
+  a.subscribe(Topic::LmMap, [&](Message&& m) {
+    std::lock_guard lock(mutex);
+    got.push_back(m.seq);
+  });
+  RawWriter raw(new hiveslam_msgs::msg::PacketPubSubType(), topicName(Topic::LmMap));
+  dds::DataWriter* writer = raw.writer();
+  ASSERT_NE(writer, nullptr);
+  ASSERT_TRUE(testing::eventually(
+      [&] {
+        dds::PublicationMatchedStatus status;
+        writer->get_publication_matched_status(status);
+        return status.current_count > 0;
+      },
+      std::chrono::seconds(10)));
+  const auto write = [&](uint64_t seq) {
+    hiveslam_msgs::msg::Packet p;
+    p.source(9);
+    p.seq(seq);
+    writer->write(&p);
+  };
+  const auto count = [&] {
+    std::lock_guard lock(mutex);
+    return got.size();
+  };
+  write(5);
+  ASSERT_TRUE(testing::eventually([&] { return count() == 1; }, std::chrono::seconds(10)));
+  write(5);  // the same again
+  write(3);  // an older one
+  write(0);  // none
+  write(6);
+  ASSERT_TRUE(testing::eventually([&] { return count() == 2; }, std::chrono::seconds(10)));
+  EXPECT_EQ(refusedOn(a, Topic::LmMap), 3u);
+  {
+    std::lock_guard lock(mutex);
+    EXPECT_EQ(got, (std::vector<uint64_t>{5, 6}));
+  }
+  a.stop();
 }
 
 }  // namespace

@@ -28,6 +28,7 @@
 #include <map>
 #include <mutex>
 #include <thread>
+#include <utility>
 #include <unordered_map>
 
 #include "common/blocking_queue.hpp"
@@ -73,6 +74,7 @@ struct DdsTransport::Impl : public dds::DomainParticipantListener {
   // from then on never waits for the teardown (which may hold `entities` long, or for good).
   std::atomic<bool> stopping{false};
   std::array<dds::DataWriter*, kTopicCount> writers{};
+  std::array<uint64_t, kTopicCount> next_seq{};  // the last sequence number written, by topic; under `entities`
   // Topics this node's permissions do not let it write (a secure domain): asked once.
   std::array<bool, kTopicCount> denied{};
   struct Reader;
@@ -82,6 +84,12 @@ struct DdsTransport::Impl : public dds::DomainParticipantListener {
   PeerHandler on_peer;
   // Which participant each peer announced itself from: a participant lost means that node left.
   std::unordered_map<uint16_t, std::pair<GuidPrefix_t, PeerInfo>> peers;
+  // The node each participant announced itself as, kept past its leaving notice (its last
+  // packets, a Done among them, may come after it) until the participant is gone; and the
+  // participants whose node id a newer incarnation took. Packets are judged by them (admits()).
+  std::map<GuidPrefix_t, uint16_t> announced_as;
+  std::map<GuidPrefix_t, bool> superseded;  // true once its refused announcement was logged
+  std::map<eprosima::fastrtps::rtps::GUID_t, uint64_t> last_seq;  // by writer
   TrafficCounter counter;
   bool running = false;
   std::thread heartbeat;
@@ -123,6 +131,13 @@ struct DdsTransport::Impl : public dds::DomainParticipantListener {
         // A reader also matches its own participant's writer of the topic (the gateway reads
         // the map topic it publishes, for a hand-over): its own packets are not news to it.
         if (!info.valid_data || p.source() == impl->self_node.load()) continue;
+        std::string why;
+        if (!impl->admits(p.source(), p.seq(), info.sample_identity.writer_guid(), why)) {
+          const uint64_t n = impl->counter.refused(topic);
+          if ((n & (n - 1)) == 0)  // the 1st, 2nd, 4th, 8th...: a flood does not flood the log
+            spdlog::warn("node {}: refused a packet on {} ({} so far): {}", impl->self_node.load(), topicName(topic), n, why);
+          continue;
+        }
         Message m;
         m.version = p.version();
         m.source = p.source();
@@ -170,19 +185,69 @@ struct DdsTransport::Impl : public dds::DomainParticipantListener {
     }
   } node_listener;
 
+  // A packet names its source node. It is refused when it comes from a participant that
+  // announced itself as another node, or as this one in an incarnation a newer one replaced (a
+  // second process with the node's id), or when its sequence number does not go past the last
+  // one of its writer (replayed, or out of order). A participant not yet heard announcing is
+  // taken at its word: its first packets may come before its announcement, at the start and
+  // at a restart. Strangers are kept out by DDS Security (--secure), not here.
+  bool admits(uint16_t source, uint64_t seq, const eprosima::fastrtps::rtps::GUID_t& writer, std::string& why) {
+    std::lock_guard lock(mutex);
+    if (superseded.count(writer.guidPrefix)) {
+      why = "from a process whose node id " + std::to_string(source) + " a newer process took";
+      return false;
+    }
+    if (auto a = announced_as.find(writer.guidPrefix); a != announced_as.end() && a->second != source) {
+      why = "it names node " + std::to_string(source) + " but comes from node " + std::to_string(a->second);
+      return false;
+    }
+    uint64_t& last = last_seq[writer];
+    if (seq <= last) {
+      why = "sequence number " + std::to_string(seq) + " after " + std::to_string(last) + " (replayed or out of order)";
+      return false;
+    }
+    last = seq;
+    return true;
+  }
+
   void peerSeen(const PeerInfo& p, const GuidPrefix_t& prefix) {
+    bool refused = false, first = false;
     {
       std::lock_guard lock(mutex);
       if (!running || p.node == self.node) return;
-      if (p.leaving) {
-        if (!peers.erase(p.node)) return;
-      } else {
-        auto it = peers.find(p.node);
-        const bool same = it != peers.end() && it->second.second.incarnation == p.incarnation &&
-                          it->second.second.hosted == p.hosted && it->second.second.seen == p.seen;
-        peers[p.node] = {prefix, p};
-        if (same) return;  // a heartbeat: nothing new
+      if (auto s = superseded.find(prefix); s != superseded.end()) {
+        refused = true;
+        first = !std::exchange(s->second, true);
+      } else if (auto it = peers.find(p.node); it != peers.end() && it->second.first != prefix) {
+        // Two participants announce one node id. The newer incarnation is the node (a restart
+        // announces before the old participant's lease ends); the other is refused from then on,
+        // its announcements and its packets.
+        if (it->second.second.incarnation > p.incarnation) {
+          refused = first = true;
+          superseded[prefix] = true;
+        } else {
+          superseded.emplace(it->second.first, false);
+        }
       }
+      if (!refused) {
+        announced_as[prefix] = p.node;
+        if (p.leaving) {
+          if (!peers.erase(p.node)) return;
+        } else {
+          auto it = peers.find(p.node);
+          const bool same = it != peers.end() && it->second.second.incarnation == p.incarnation &&
+                            it->second.second.hosted == p.hosted && it->second.second.seen == p.seen;
+          peers[p.node] = {prefix, p};
+          if (same) return;  // a heartbeat: nothing new
+        }
+      }
+    }
+    if (refused) {
+      noteDroppedAnnouncement();
+      if (first)
+        spdlog::warn("node {}: dropped an announcement: two processes announce node {}; the one started later is the node",
+                     self_node.load(), p.node);
+      return;
     }
     peer_events.push({p, !p.leaving});
   }
@@ -200,6 +265,10 @@ struct DdsTransport::Impl : public dds::DomainParticipantListener {
         info.status != ParticipantDiscoveryInfo::DROPPED_PARTICIPANT)
       return;
     std::lock_guard lock(mutex);
+    const GuidPrefix_t gone = info.info.m_guid.guidPrefix;
+    announced_as.erase(gone);
+    superseded.erase(gone);
+    std::erase_if(last_seq, [&](const auto& w) { return w.first.guidPrefix == gone; });
     for (auto it = peers.begin(); it != peers.end();) {
       if (it->second.first == info.info.m_guid.guidPrefix) {
         peer_events.push({it->second.second, false});
@@ -364,7 +433,6 @@ void DdsTransport::publish(Topic topic, Message&& m) {
   p.source(m.source);
   p.kind(m.kind);
   p.target(m.target);
-  p.seq(m.seq);
   p.map_id(m.map);
   p.epoch(m.epoch);
   p.raw_size(m.raw_size);
@@ -374,6 +442,8 @@ void DdsTransport::publish(Topic topic, Message&& m) {
   std::lock_guard lock(d.entities);
   if (d.closed) return;
   dds::DataWriter* writer = d.writerFor(topic);
+  // Numbered under the lock that orders the writes: a reader refuses one that goes back.
+  p.seq(++d.next_seq[static_cast<size_t>(topic)]);
   if (writer && writer->write(&p)) {
     d.counter.sent(topic, bytes);
     spdlog::debug("node {}: out {} kind {} map {} seq {} {} B", d.self_node.load(), topicName(topic), p.kind(), p.map_id(),
