@@ -184,6 +184,7 @@ void DistributedNode::onPeer(const PeerInfo& peer, bool present) {
   }
   bool newcomer = false, restarted = false, leaving = false, rejoined = false;
   const Plan before = plan();
+  const auto maps_here = slam_.liveMaps();  // before mutex_: the atlas takes locks of its own
   {
     std::lock_guard lock(mutex_);
     // A node released here is gone for this node already: its announcements until the Release
@@ -196,10 +197,15 @@ void DistributedNode::onPeer(const PeerInfo& peer, bool present) {
     const auto gone = gone_incarnations_.find(peer.node);
     rejoined = newcomer && gone != gone_incarnations_.end() && gone->second == peer.incarnation;
     if (gone != gone_incarnations_.end()) gone_incarnations_.erase(gone);
-    if (rejoined && peer.task == Task::Tracking && options_.task != Task::Tracking)
+    if (rejoined && peer.task == Task::Tracking && options_.task != Task::Tracking) {
       adopt_from_[peer.node].clear();
-    else if (newcomer)
+      auto& known = known_at_return_[peer.node];
+      known.clear();
+      for (const auto& m : maps_here) known.insert(m->id);
+    } else if (newcomer) {
       adopt_from_.erase(peer.node);
+      known_at_return_.erase(peer.node);
+    }
     peers_[peer.node] = peer;
     had_mapping_peer_ = had_mapping_peer_ || peer.task == Task::Mapping;
   }

@@ -125,7 +125,8 @@ class DistributedNode final : public core::SystemEvents {
   bool holdForAdoption(std::vector<MapRecord>& batches);
   // Held updates applied: those of `map` (all maps if kNoId); with `adopted`, only one that
   // covers it (StateIntegrator::covers), the others dropped as older than the adopted map.
-  void releaseHeldUpdates(core::Id map, const std::vector<MapRecord>* adopted);
+  // With `expired`, only those held longer than the hand-over wait (a map never handed over).
+  void releaseHeldUpdates(core::Id map, const std::vector<MapRecord>* adopted, bool expired = false);
   void onControl(const communication::Message& m, communication::Topic topic);
   // The gateway's part of the end of a run. Returns whether the LC (if any) answered.
   bool finishAsGateway();
@@ -224,8 +225,16 @@ class DistributedNode final : public core::SystemEvents {
   // LM, LC: tracking nodes back from a partition, by node, and the maps already taken whole
   // from them (the first global map of each: StateIntegrator::adoptGlobal). Guarded by mutex_.
   std::map<uint16_t, std::set<core::Id>> adopt_from_;
-  // The gateway: LC's latest update of each map held by holdForAdoption. Guarded by mutex_.
-  std::map<core::Id, std::vector<MapRecord>> held_updates_;
+  // LM, LC: the maps this node held when each of those tracking nodes came back: those it
+  // hands over (a map made since comes as keyframes, not whole). Guarded by mutex_.
+  std::map<uint16_t, std::set<core::Id>> known_at_return_;
+  // The gateway: LC's latest update of each map held by holdForAdoption, and since when.
+  // Guarded by mutex_.
+  struct HeldUpdate {
+    std::vector<MapRecord> batches;
+    std::chrono::steady_clock::time_point since;
+  };
+  std::map<core::Id, HeldUpdate> held_updates_;
   // Peers that left and have not come back (StateIntegrator::setDeparted). Its own lock, taken
   // last: the integrator asks with a map's mutex held.
   mutable std::mutex departed_mutex_;

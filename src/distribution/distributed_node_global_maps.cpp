@@ -56,6 +56,7 @@ void DistributedNode::onGlobal(std::vector<MapRecord>&& batches, Topic topic, ui
     return;
   }
   if (topic == Topic::LcMap) {
+    releaseHeldUpdates(core::kNoId, nullptr, true);
     if (!holdForAdoption(batches)) applyLoopClosingUpdate(batches);
     return;
   }
@@ -124,38 +125,44 @@ void DistributedNode::applyLoopClosingUpdate(const std::vector<MapRecord>& batch
 
 bool DistributedNode::holdForAdoption(std::vector<MapRecord>& batches) {
   const core::Id map_id = batches.front().map;
+  const bool here = slam_.findMap(map_id) != nullptr;  // before mutex_, as in onPeer
   std::lock_guard lock(mutex_);
   // LC may take the returning tracking node's map before this node does (each gets its own
   // copy). Applied to this node's map, which still lacks what TR mapped alone, the relay that
   // follows lists none of those keyframes, and TR erased them as culled here: it ended a 30 s
-  // cut from both peers with 19 of the 85 keyframes LM and LC held.
+  // cut from both peers with 19 of the 85 keyframes LM and LC held. Awaited: the maps held here
+  // at the return and those not here at all (made during the cut), until taken whole.
   const bool awaited = std::any_of(adopt_from_.begin(), adopt_from_.end(), [&](const auto& a) {
-    return peers_.count(a.first) && !a.second.count(map_id);
+    const auto known = known_at_return_.find(a.first);
+    const bool handed_over = !here || (known != known_at_return_.end() && known->second.count(map_id));
+    return peers_.count(a.first) && !a.second.count(map_id) && handed_over;
   });
   if (!awaited) return false;
   auto& held = held_updates_[map_id];
-  if (!held.empty() && held.front().epoch > batches.front().epoch) return true;  // a newer one waits
+  if (!held.batches.empty() && held.batches.front().epoch > batches.front().epoch) return true;  // a newer one waits
   spdlog::info("node {}: LC's update of map {} (epoch {}) waits for the map of a node back from a partition",
                options_.id, map_id, batches.front().epoch);
-  held = std::move(batches);
+  if (held.batches.empty()) held.since = std::chrono::steady_clock::now();
+  held.batches = std::move(batches);
   return true;
 }
 
-void DistributedNode::releaseHeldUpdates(core::Id map, const std::vector<MapRecord>* adopted) {
+void DistributedNode::releaseHeldUpdates(core::Id map, const std::vector<MapRecord>* adopted, bool expired) {
   std::vector<std::vector<MapRecord>> ready;
   {
     std::lock_guard lock(mutex_);
+    const auto too_old = std::chrono::steady_clock::now() - std::chrono::milliseconds(options_.settings.handover_wait_ms);
     for (auto it = held_updates_.begin(); it != held_updates_.end();) {
-      if (map != core::kNoId && it->first != map) {
+      if ((map != core::kNoId && it->first != map) || (expired && it->second.since > too_old)) {
         ++it;
         continue;
       }
-      if (!adopted || StateIntegrator::covers(it->second, *adopted)) {
-        ready.push_back(std::move(it->second));
+      if (!adopted || StateIntegrator::covers(it->second.batches, *adopted)) {
+        ready.push_back(std::move(it->second.batches));
       } else {
         ++globals_ignored_;
         spdlog::info("node {}: LC's update of map {} (epoch {}) dropped: made before LC took the map back from the "
-                     "partition", options_.id, it->first, it->second.front().epoch);
+                     "partition", options_.id, it->first, it->second.batches.front().epoch);
       }
       it = held_updates_.erase(it);
     }
