@@ -186,13 +186,14 @@ TEST(BadInput, CommandLinePrintsOneLineAndFails) {
   expectOneLineFailure("info /nonexistent/hiveslam/dataset", "dataset not found: /nonexistent/hiveslam/dataset");
 }
 
-// The live view's commands and settings: a bad domain, port or rate is one line and an exit,
+// The live view's commands and settings: a bad domain, port, niceness or rate is one line and an exit,
 // before anything listens.
 TEST(BadInput, TheLiveViewChecksItsDomainPortAndRates) {
   testing::TempDir dir;
   expectOneLineFailure("view --domain 233", "DDS domain must be 0-232");
   expectOneLineFailure("topics --domain 233", "DDS domain must be 0-232");
   expectOneLineFailure("view --port 70000 --seconds 1", "viewer port must be 0-65535");
+  expectOneLineFailure("view --nice 20 --seconds 1", "--nice must be 0-19");
   std::ofstream(dir / "slow.yaml") << "view: {cloud_hz: 0}\n";
   expectOneLineFailure("view --seconds 1 --config " + (dir / "slow.yaml").string(), "view settings out of range");
   std::ofstream(dir / "typo.yaml") << "view: {cloud_hzz: 1}\n";
