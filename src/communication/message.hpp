@@ -31,7 +31,7 @@ struct Message {
   uint16_t source = 0;   // sending node
   uint8_t kind = 0;      // distribution::PacketKind
   uint8_t target = 0;
-  uint64_t seq = 0;      // per (source, topic), from 1
+  uint64_t seq = 0;      // per (source, topic), from 1; set by the DDS transport as it writes
   uint64_t map = 0;
   uint64_t epoch = 0;
   uint32_t raw_size = 0;  // body size before compression

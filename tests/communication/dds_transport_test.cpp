@@ -222,10 +222,10 @@ TEST(DdsTransport, AReaderThatMatchesLateGetsOnlyWhatIsWrittenAfter) {
   self_a.node = 1;
   self_b.node = 2;
   a.start(self_a, [](const PeerInfo&, bool) {});
+  // The transport numbers what it writes, from 1: the 4th packet arrives as seq 4.
   const auto packet = [](uint64_t seq) {
     Message m;
     m.source = 1;
-    m.seq = seq;
     m.body.assign(3000, static_cast<uint8_t>(seq));  // fragmented: over one datagram
     return m;
   };
