@@ -59,21 +59,32 @@ void KeyframePublisher::publish(const Job& job) {
   }
   KeyFrameMessage m;
   uint64_t label = 0;
+  // Queued before its map was merged into another here: the keyframe lives in the merged map
+  // now, in that map's frame, and goes out as that map's. Sent as the old map's, in a pose the
+  // merge had moved, LM could not place it, and TR ended a run holding it alone. (Maps stay in
+  // the atlas once merged: the pointers stay valid.)
+  core::Map* map = job.map->resolve();
+  std::unique_lock lock(map->mutex);
+  while (map->merged_into.load()) {
+    lock.unlock();
+    map = map->resolve();
+    lock = std::unique_lock(map->mutex);
+  }
+  if (map != job.map.get()) maps_started_[map->id] = true;  // the receiver holds it already
   {
-    std::lock_guard lock(job.map->mutex);
     const core::KeyFrame& kf = *job.keyframe;
     // Culled before its turn: its erasure goes out with the map's journal. Sent, it was made
     // again at the receiver, which would hold it alone.
     if (kf.bad) return;
-    label = label_ ? label_(*job.map) : 0;
-    m.keyframe = captureKeyframe(kf, job.map->id, true);
+    label = label_ ? label_(*map) : 0;
+    m.keyframe = captureKeyframe(kf, map->id, true);
     std::vector<const core::KeyFrame*> with_points{&kf};
     // A new map's first keyframe travels with its second (the receiver builds the map from them).
-    if (!maps_started_[job.map->id]) {
-      maps_started_[job.map->id] = true;
-      for (const auto& [id, other] : job.map->keyframes)
+    if (!maps_started_[map->id]) {
+      maps_started_[map->id] = true;
+      for (const auto& [id, other] : map->keyframes)
         if (other.get() != &kf && other->id < kf.id) {
-          m.companions.push_back(captureKeyframe(*other, job.map->id, true));
+          m.companions.push_back(captureKeyframe(*other, map->id, true));
           with_points.push_back(other.get());
         }
     }
@@ -85,7 +96,7 @@ void KeyframePublisher::publish(const Job& job) {
         }
     // Tracking's counts for points made since the last few keyframes (local mapping's
     // candidates for culling), found among the keyframe's neighbours.
-    auto& recent = recent_[job.map->id];
+    auto& recent = recent_[map->id];
     if (job.topic == communication::Topic::TrKeyframes && !recent.empty()) {
       const core::Id since = recent.front();
       std::set<core::MapPoint*, core::ById> seen;
@@ -99,9 +110,10 @@ void KeyframePublisher::publish(const Job& job) {
     recent.push_back(kf.id);
     if (recent.size() > 4) recent.pop_front();
   }
+  lock.unlock();
   observer_.record(m.keyframe);
   for (const auto& p : m.points) observer_.record(p, m.keyframe.map);
-  transport_.publish(job.topic, pack(m, node_, job.target, job.map->id, label));
+  transport_.publish(job.topic, pack(m, node_, job.target, map->id, label));
   ++published_;
 }
 

@@ -4,12 +4,26 @@
 
 namespace hiveslam::distribution {
 
+Id Observer::resolve(Id map) const {
+  // A chain of merges is short; bounded all the same against a cycle in hostile records.
+  for (size_t hops = 0; hops <= merged_into_.size(); ++hops) {
+    auto it = merged_into_.find(map);
+    if (it == merged_into_.end()) break;
+    map = it->second;
+  }
+  return map;
+}
+
 void Observer::record(const KeyFrameRecord& k) {
   std::lock_guard lock(mutex_);
   if (erased_keyframes_.count(k.id)) return;
   auto& stored = keyframes_[k.id];
   const bool keep_links = !k.links && stored.id == k.id;
   KeyFrameRecord light = k;
+  // Sent before its sender applied a merge that this node has: S_full files it under the map
+  // it lives in now (under the old map, no later snapshot could prune it, and TR's S_full
+  // ended a run listing a keyframe its map had culled).
+  light.map = resolve(k.map);
   light.full = false;
   light.frame = core::Frame();
   if (keep_links) {
@@ -24,7 +38,7 @@ void Observer::record(const KeyFrameRecord& k) {
 void Observer::record(const PointRecord& p, Id map) {
   std::lock_guard lock(mutex_);
   if (erased_points_.count(p.id)) return;
-  if (map != kNoId) point_map_[p.id] = map;
+  if (map != kNoId) point_map_[p.id] = resolve(map);
   auto it = points_.find(p.id);
   // A position alone is not a point yet (as in the core map: StateIntegrator::applyPoint).
   if (it == points_.end() && !p.full) return;
@@ -39,6 +53,8 @@ void Observer::record(const MapRecord& m) {
   if (!m.merged_maps.empty()) {
     std::lock_guard lock(mutex_);
     const std::unordered_set<Id> merged(m.merged_maps.begin(), m.merged_maps.end());
+    for (Id id : merged)
+      if (id != m.map) merged_into_[id] = m.map;
     for (auto& [id, k] : keyframes_)
       if (merged.count(k.map)) k.map = m.map;
     for (auto& [id, map] : point_map_)

@@ -26,7 +26,8 @@ class Observer {
   void record(const KeyFrameRecord& k);  // frame data is not kept (the core keyframe has it)
   void record(const PointRecord& p, Id map);
   // Keyframes, points and erasures of one batch; the records of maps it lists as merged into
-  // its map belong to that map from now on.
+  // its map belong to that map from now on, and so do records that come later naming a merged
+  // map.
   void record(const MapRecord& m);
   void eraseKeyframe(Id id);
   // After an authoritative snapshot of `snapshot.map`: records of that map (or of the maps it
@@ -55,6 +56,8 @@ class Observer {
   std::unordered_map<Id, KeyFrameRecord> keyframes_;
   std::unordered_map<Id, PointRecord> points_;
   std::unordered_map<Id, Id> point_map_;  // the map each point record came with
+  std::unordered_map<Id, Id> merged_into_;  // a merged map -> the map it went into
+  Id resolve(Id map) const;                 // the map a record of `map` belongs to now
   std::unordered_set<Id> erased_keyframes_, erased_points_;
   // Global map batches being collected, by map and sender, for one epoch at a time (a newer
   // epoch drops an unfinished older one). Epochs are counted by each sender: a gateway that

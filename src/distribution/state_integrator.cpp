@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cstring>
+#include <optional>
 #include <set>
 #include <unordered_set>
 
@@ -186,7 +187,16 @@ bool StateIntegrator::current(const core::Map& map, uint64_t label) const {
 StateIntegrator::Added StateIntegrator::addKeyframe(const KeyFrameMessage& m, uint64_t label) {
   Added out;
   auto map = mapFor(m.keyframe.map);
-  if (!map) return out;
+  // Posed in a map that has been merged into another here since: the sender had not applied
+  // the merge yet. It goes into the merged map, carried from the keyframe it was posed from
+  // as a stale one is (dropped, it lived on at TR alone: a CI run ended with TR one keyframe
+  // ahead of LM and LC).
+  std::shared_ptr<core::Map> posed_in;
+  if (!map) {
+    posed_in = slam_.findMap(m.keyframe.map);
+    if (posed_in) map = slam_.findMap(posed_in->resolve()->id);
+    if (!map || map->merged_into.load()) return out;
+  }
   // Features and bag of words are computed before the lock.
   std::vector<std::shared_ptr<core::KeyFrame>> companions;
   for (const auto& c : m.companions) companions.push_back(makeKeyframe(c));
@@ -218,17 +228,27 @@ StateIntegrator::Added StateIntegrator::addKeyframe(const KeyFrameMessage& m, ui
     // tells whether it waits in this node's queue through one.
     kf->made_in_epoch = map->epoch;
     if (kf->made_from) kf->made_pose.scale = kf->made_from->scale();  // the record's is the label's frame
-    if (stale(*map, label)) {
-      if (kf->made_from) {
-        // The correction may have rescaled the map around the keyframe it was posed from.
-        double then = 1.0;
-        {
-          std::lock_guard epochs(epochs_mutex_);
-          if (const Frame* f = frameOf(*map, label))
-            if (auto s = f->scales.find(kf->made_from->id); s != f->scales.end()) then = s->second;
-        }
-        const double change = kf->made_from->scale() / then;
-        kf->T_cw = kf->made_from->poseOf({kf->made_pose.T_c_k, then});
+    // The made_from keyframe's scale() in the frame the label stood for; unknown for a merged
+    // map's label this node never noted.
+    std::optional<double> then;
+    if (kf->made_from) {
+      std::lock_guard epochs(epochs_mutex_);
+      if (const Frame* f = frameOf(posed_in ? *posed_in : *map, label)) {
+        auto s = f->scales.find(kf->made_from->id);
+        then = s != f->scales.end() ? s->second : 1.0;
+      } else if (!posed_in || label == 0) {
+        then = 1.0;  // before the map's first correction
+      }
+    }
+    if (posed_in && !then) {
+      spdlog::warn("keyframe {} of node {}, posed in map {} before its merge, dropped: nothing here to carry it by", kf->id,
+                   core::IdGenerator::node(kf->id), posed_in->id);
+      return out;
+    }
+    if (posed_in || stale(*map, label)) {
+      if (then) {
+        const double change = kf->made_from->scale() / *then;
+        kf->T_cw = kf->made_from->poseOf({kf->made_pose.T_c_k, *then});
         kf->made_pose = kf->made_from->relative(kf->T_cw);
         for (auto p : m.points)
           if (!map->points.count(p.id)) {
@@ -267,6 +287,7 @@ StateIntegrator::Added StateIntegrator::addKeyframe(const KeyFrameMessage& m, ui
   for (const auto& p : applied) observer_.record(p, map->id);
   for (const auto& c : m.companions) observer_.record(c);
   KeyFrameRecord placed = m.keyframe;
+  placed.map = map->id;
   placed.T_cw = kf->T_cw;
   observer_.record(placed);
   out.map = map;

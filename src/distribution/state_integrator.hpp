@@ -33,9 +33,10 @@ class StateIntegrator {
   StateIntegrator(core::SlamSystem& slam, Observer& observer) : slam_(slam), observer_(observer) {}
 
   // A new keyframe (with its new points and, for a new map, its first keyframe). Returns the
-  // core keyframe and its map, not yet given to a module; null when its map is gone (merged).
-  // One labelled with an older frame is re-posed from where tracking posed it (relative to a
-  // keyframe both nodes hold), and the points it brings move with it. One held already
+  // core keyframe and its map, not yet given to a module. One labelled with an older frame, or
+  // posed in a map merged into another since, is re-posed from where tracking posed it
+  // (relative to a keyframe both nodes hold) and the points it brings move with it; null when
+  // no such keyframe is held. One held already
   // (`held`) came first in a hand-over snapshot taken after it was sent: it is returned as it
   // is (the snapshot's pose is the newer), still to be given to the module it was sent to.
   struct Added {

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "core/camera/pinhole_radtan.hpp"
+#include "core/loop/map_correction.hpp"
 #include "core/mapping/keyframe_gap.hpp"
 #include "core/system/slam_system.hpp"
 #include "eval/similarity.hpp"
@@ -240,6 +241,66 @@ TEST(SlamSystem, ARevisitAfterANewMapRelocalizesInTheOldMap) {
   EXPECT_GE(slam.relocalizedInKnownMap(), 1);
   EXPECT_GE(in_first_map, 25);
   EXPECT_EQ(slam.liveMaps().size(), 2u);
+}
+
+// Another node merges the map tracking is in into another one (at TR, LC's merge of TR's old map
+// into its newer one came right after TR had relocalized in the old one). Tracking follows the
+// map into the merged one and goes on in its frame: before, it kept tracking in the emptied map
+// and its next keyframe went there, seen by points of the merged map (an atlas with dangling
+// observations, and a keyframe TR alone lacked).
+TEST(SlamSystem, TrackingFollowsItsMapIntoTheMapItWasMergedInto) {
+  const Sweep sweep;
+  SlamSettings settings;
+  settings.loop_closing = false;  // the merge comes from outside
+  SlamSystem slam(settings, sweep.camera, SlamSystem::Mode::Sequential, shippedVocabulary());
+  const cv::Mat blank(sweep.model.lens.height, sweep.model.lens.width, CV_8UC1, cv::Scalar(128));
+  double t = 0;
+  for (int f = 0; f < 100; ++f) slam.process(sweep.model.renderImage(f, sweep.rays), t += 0.05);
+  const Id first_map = slam.frames().back().map;
+  for (int f = 0; f < settings.lost_frames_before_new_map + 5; ++f) slam.process(blank, t += 0.05);
+  for (int f = 450; f < 540; ++f) slam.process(sweep.model.renderImage(f, sweep.rays), t += 0.05);
+  const Id second_map = slam.frames().back().map;
+  ASSERT_NE(second_map, first_map);
+  for (int f = 0; f < settings.lost_frames_before_new_map + 5; ++f) slam.process(blank, t += 0.05);
+  for (int f = 30; f < 45; ++f) slam.process(sweep.model.renderImage(f, sweep.rays), t += 0.05);
+  ASSERT_TRUE(slam.frames().back().tracked);
+  ASSERT_EQ(slam.frames().back().map, first_map);
+  const Eigen::Vector3d center_before = slam.poseOf(slam.frames().back()).translation();
+
+  // The merge as a node applies one: the first map's contents move into the second by S.
+  const Sim3 S(Eigen::Quaterniond(Eigen::AngleAxisd(0.5, Eigen::Vector3d::UnitY())), {3.0, -1.0, 2.0}, 1.5);
+  const auto first = slam.findMap(first_map), second = slam.findMap(second_map);
+  {
+    std::scoped_lock both(first->mutex, second->mutex);
+    PoseCorrection c;
+    for (const auto& [id, kf] : first->keyframes) {
+      c.before[kf.get()] = Sim3(kf->T_cw);
+      c.after[kf.get()] = Sim3(Eigen::Quaterniond::Identity(), Eigen::Vector3d::Zero(), S.s) * Sim3(kf->T_cw) * S.inverse();
+    }
+    for (const auto& [id, p] : first->points) c.points[p.get()] = S * p->position;
+    second->absorb(*first);
+    slam.database().moveMap(first.get(), second.get());
+    applyCorrection(*second, c, slam.scales());
+  }
+
+  int tracked = 0, in_second = 0;
+  for (int f = 45; f < 75; ++f) {
+    const auto& r = slam.process(sweep.model.renderImage(f, sweep.rays), t += 0.05);
+    tracked += r.tracked;
+    in_second += r.tracked && slam.currentMapId(r.map) == second_map && r.map == second_map;
+    if (f == 45 && r.tracked) {
+      const Eigen::Vector3d center_after = slam.poseOf(r).translation();
+      EXPECT_LT((S.inverse() * center_after - center_before).norm(), 0.05) << "the first frame after the merge, in its frame";
+    }
+  }
+  slam.finish();
+  EXPECT_GE(tracked, 27);
+  EXPECT_EQ(in_second, tracked);
+  EXPECT_TRUE(first->keyframes.empty()) << "a keyframe went into the merged-away map";
+  // Every observation in the merged map is of one of its keyframes.
+  std::lock_guard lock(second->mutex);
+  for (const auto& [id, p] : second->points)
+    for (const auto& [kf, i] : p->observations) ASSERT_TRUE(second->keyframes.count(kf->id)) << "point " << id;
 }
 
 // A long run keeps the matches for refineFrames of its last refine_frames_window frames only: a

@@ -89,5 +89,33 @@ TEST(ObserverGlobals, ASenderThatLeavesTakesItsUnfinishedGlobalMapWithIt) {
   EXPECT_EQ(lc->front().epoch, 5u);
 }
 
+// TR queued a keyframe of map 7 and published it after LC's merge of 7 into 8 had reached it:
+// S_full files the record under map 8, so the next snapshot of 8 that lacks it (LM culled it)
+// prunes it. Filed under 7, it stayed in TR's S_full after its map had culled it.
+TEST(ObserverMerges, ARecordNamingAMergedMapBelongsToTheMapItWentInto) {
+  Observer o;
+  MapRecord merge;
+  merge.kind = MapRecord::Kind::Global;
+  merge.map = 8;
+  merge.merged_maps = {7};
+  o.record(merge);
+  KeyFrameRecord late;
+  late.id = 40;
+  late.map = 7;
+  o.record(late);
+  PointRecord p;
+  p.id = 41;
+  p.full = true;
+  o.record(p, 7);
+  ASSERT_EQ(o.keyframeCount(), 1u);
+  MapRecord snapshot;
+  snapshot.kind = MapRecord::Kind::Global;
+  snapshot.map = 8;
+  const auto known = [](Id) { return true; };
+  o.prune(snapshot, {}, {}, known, known);
+  EXPECT_EQ(o.keyframeCount(), 0u);
+  EXPECT_FALSE(o.hasPoint(41));
+}
+
 }  // namespace
 }  // namespace hiveslam::distribution

@@ -189,6 +189,19 @@ class EpochLabels : public ::testing::Test {
     return m;
   }
 
+  // The same, seeing a new point at (0.3, 0.2, 4.5) in the message's frame.
+  static KeyFrameMessage keyframeWithPointOnSecond(const Eigen::Isometry3d& T_second) {
+    KeyFrameMessage m = keyframeOnSecond(T_second);
+    m.keyframe.matches.emplace_back(kPoints, kNewPoint);
+    PointRecord p;
+    p.id = kNewPoint;
+    p.position = Eigen::Vector3d(0.3, 0.2, 4.5);
+    p.full = true;
+    p.first_keyframe = 13;
+    m.points.push_back(p);
+    return m;
+  }
+
   static void expectPose(const core::KeyFrame& kf, const Eigen::Isometry3d& want) {
     EXPECT_LT((kf.T_cw.translation() - want.translation()).norm(), 1e-9);
     EXPECT_LT(Eigen::AngleAxisd(want.linear().transpose() * kf.T_cw.linear()).angle(), 1e-9);
@@ -249,14 +262,8 @@ TEST_F(EpochLabels, AKeyframeMadeBeforeTheCorrectionIsRePosedWithItsPointsScaleI
   const core::Sim3 S(Eigen::Quaterniond(Eigen::AngleAxisd(0.2, Eigen::Vector3d::UnitX())), {0.5, 2.0, -1.0}, 1.2);
   correct(S);
   // Tracking posed it in the old frame; it brings a point.
-  KeyFrameMessage m = keyframeOnSecond(poseAt(0.4));
-  m.keyframe.matches.emplace_back(kPoints, kNewPoint);
-  PointRecord p;
-  p.id = kNewPoint;
-  p.position = Eigen::Vector3d(0.3, 0.2, 4.5);
-  p.full = true;
-  p.first_keyframe = 13;
-  m.points.push_back(p);
+  const KeyFrameMessage m = keyframeWithPointOnSecond(poseAt(0.4));
+  const PointRecord& p = m.points.front();
   const auto added = integrator_.addKeyframe(m, 0);
   ASSERT_TRUE(added.keyframe);
   expectPose(*added.keyframe, moved(m.keyframe.T_cw, S));
@@ -354,6 +361,52 @@ TEST_F(EpochLabels, AKeyframeFromFarBehindIsStillRePosed) {
   const auto added = integrator_.addKeyframe(m, 1);
   ASSERT_TRUE(added.keyframe);
   expectPose(*added.keyframe, m.keyframe.T_made_from * moved(poseAt(0.4), S2));
+}
+
+// Tracking posed a keyframe in a map that loop closing has since merged into another: the merge
+// reached this node first. The keyframe goes into the merged map, re-posed from the keyframe it
+// was posed from and with its point moved by the merge; dropped, it lived on at TR alone (a CI
+// run ended with TR one keyframe ahead of LM and LC).
+TEST_F(EpochLabels, AKeyframeOfAMapMergedSinceGoesIntoTheMergedMap) {
+  constexpr Id kOther = 8, kOtherFirst = 21;
+  KeyFrameMessage first;
+  first.keyframe.id = kOtherFirst;
+  first.keyframe.map = kOther;
+  first.keyframe.full = true;
+  first.keyframe.frame = featureFrame(kPoints + 1);
+  first.keyframe.T_cw = poseAt(2.0);
+  ASSERT_TRUE(integrator_.addKeyframe(first, 0).keyframe);
+  // The merge: this node's map moves by S into the other map's frame.
+  const core::Sim3 S(Eigen::Quaterniond(Eigen::AngleAxisd(0.4, Eigen::Vector3d::UnitY())), {1.0, 0.5, -2.0}, 0.8);
+  MapRecord g;
+  g.kind = MapRecord::Kind::Global;
+  g.map = kOther;
+  g.epoch = 1;
+  g.merged_maps = {kMap};
+  g.keyframes.push_back(keyframeRecord(kOtherFirst, poseAt(2.0)));
+  g.keyframes.back().map = kOther;
+  for (Id kf : {kFirst, kSecond}) {
+    g.keyframes.push_back(keyframeRecord(kf, moved(poseAt(kf == kFirst ? 0.0 : 0.4), S)));
+    g.keyframes.back().map = kOther;
+  }
+  addPoints(g, kPoints, S);
+  ASSERT_TRUE(integrator_.applyGlobal({g}, false));
+  ASSERT_TRUE(slam_.findMap(kMap)->merged_into.load());
+
+  // Labelled 0: the merged map never had a correction.
+  const KeyFrameMessage m = keyframeWithPointOnSecond(poseAt(0.4));
+  const PointRecord& p = m.points.front();
+  const auto added = integrator_.addKeyframe(m, 0);
+  ASSERT_TRUE(added.keyframe);
+  ASSERT_TRUE(added.map);
+  EXPECT_EQ(added.map->id, kOther);
+  expectPose(*added.keyframe, moved(m.keyframe.T_cw, S));
+  std::lock_guard lock(added.map->mutex);
+  ASSERT_TRUE(added.map->points.count(kNewPoint));
+  EXPECT_LT((added.map->points.at(kNewPoint)->position - S * p.position).norm(), 1e-9);
+  const auto recorded = observer_.digest().keyframes;  // S_full has it where the map has it
+  ASSERT_TRUE(recorded.count(13));
+  EXPECT_LT((recorded.at(13).translation() - added.keyframe->T_cw.translation()).norm(), 1e-9);
 }
 
 // The other way round: the sender applied a global map that is still on its way here, so its

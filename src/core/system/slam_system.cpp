@@ -332,11 +332,8 @@ const FrameRecord& SlamSystem::process(const cv::Mat& gray, double timestamp) {
       abort_ba_ = true;  // a newer keyframe: the running local BA stops early
       jobs_.push({tracker_.map(), out.new_keyframe});
     } else if (!here) {
-      {
-        std::lock_guard lock(tracker_.map()->mutex);
-        insertKeyframe(*tracker_.map(), *out.new_keyframe, extractor_.scales(), &database_);
-      }
-      if (events_) events_->keyframeCreated(tracker_.map(), out.new_keyframe);
+      const auto map = insertOwnKeyframe(out.new_keyframe);
+      if (events_) events_->keyframeCreated(map, out.new_keyframe);
     } else {
       mapper_.process(tracker_.map(), out.new_keyframe, nullptr, beforeBa(tracker_.map(), out.new_keyframe));
       if (events_) events_->keyframeMapped(tracker_.map(), out.new_keyframe);
@@ -351,6 +348,30 @@ const FrameRecord& SlamSystem::process(const cv::Mat& gray, double timestamp) {
     std::vector<FrameObservation>().swap(records_[records_.size() - 1 - window].observations);
   if (frame_listener_) frame_listener_(records_.back(), out.T_cw, keypoints, gray);
   return records_.back();
+}
+
+std::shared_ptr<Map> SlamSystem::insertOwnKeyframe(const std::shared_ptr<KeyFrame>& kf) {
+  std::shared_ptr<Map> map = tracker_.map();
+  bool moved = false;
+  for (int hops = 0;; ++hops) {
+    std::unique_lock lock(map->mutex);
+    if (!map->merged_into.load() || hops == 8) {
+      // Merged since tracking posed it (another node's merge, applied here in between): it goes
+      // into the merged map, re-posed from the keyframe it was posed from, which the merge moved.
+      if (moved && kf->made_from) {
+        kf->T_cw = kf->made_from->poseOf(kf->made_pose);
+        kf->made_in_epoch = map->epoch;
+      }
+      insertKeyframe(*map, *kf, extractor_.scales(), &database_);
+      return map;
+    }
+    const Map* into = map->resolve();
+    lock.unlock();
+    if (auto next = findMap(into->id)) {
+      map = std::move(next);
+      moved = true;
+    }
+  }
 }
 
 void SlamSystem::dropCulledKeyframeImages() {

@@ -174,6 +174,9 @@ class SlamSystem {
   // many keyframes as it makes (a 30-minute soak of figure8 ended with 86), and each culled one's
   // image (361 KB at 752x480) stayed until the 512 MB budget was spent.
   void dropCulledKeyframeImages();
+  // A keyframe tracking made while another node maps: into tracking's map, or the map that one
+  // has been merged into since. Returns the map it went into.
+  std::shared_ptr<Map> insertOwnKeyframe(const std::shared_ptr<KeyFrame>& kf);
   // The image of the current initialization attempt's first frame (tracking thread only): a new
   // map's first keyframe is made of it, frames after it was seen.
   cv::Mat initialization_image_;

@@ -45,7 +45,7 @@ TrackingOutput Tracker::track(Frame frame, bool mapping_idle) {
     }
     out.map_switched = true;
   } else {
-    lock = std::unique_lock(map_->mutex);
+    lock = followMerges();
     // Loop closing, a merge or a global BA moved the map: the last frame's pose is re-derived
     // from its reference keyframe, as the motion model predicts from it.
     if (map_->epoch != epoch_seen_) {
@@ -146,6 +146,24 @@ TrackingOutput Tracker::track(Frame frame, bool mapping_idle) {
   }
   last_ = std::move(current);
   return out;
+}
+
+std::unique_lock<std::mutex> Tracker::followMerges() {
+  std::unique_lock lock(map_->mutex);
+  // Merged into another map since the last frame: a merge another node made, applied here,
+  // need not keep the map tracking is in (LC's merge of TR's old map into its newer one came
+  // just after TR had relocalized in the old one). Its keyframes and points live in the
+  // other map now, and so does tracking; the merge moved them, so the last frame is re-posed.
+  for (int hops = 0; map_->merged_into.load() && map_finder_ && hops < 8; ++hops) {
+    const Map* into = map_->resolve();
+    lock.unlock();
+    if (auto next = map_finder_(into)) {
+      map_ = std::move(next);
+      epoch_seen_ = std::numeric_limits<uint64_t>::max();
+    }
+    lock = std::unique_lock(map_->mutex);
+  }
+  return lock;
 }
 
 void Tracker::startInMap(const std::shared_ptr<Map>& map) {

@@ -141,6 +141,8 @@ class Tracker {
   int keyframes_made_busy_ = 0;
   int relocalized_in_known_map_ = 0;
   std::function<std::shared_ptr<Map>(const Map*)> map_finder_;
+  // Locks the map tracking is in, after following it into the map it was merged into, if any.
+  std::unique_lock<std::mutex> followMerges();
   std::function<void()> wait_for_mapping_;
   const place::Vocabulary* vocabulary_ = nullptr;
   const KeyframeDatabase* database_ = nullptr;
