@@ -202,9 +202,15 @@ void DistributedNode::onPeer(const PeerInfo& peer, bool present) {
       auto& known = known_at_return_[peer.node];
       known.clear();
       for (const auto& m : maps_here) known.insert(m->id);
+      if (options_.task == Task::LoopClosing) {
+        handover_due_[peer.node] =
+            std::chrono::steady_clock::now() + std::chrono::milliseconds(options_.settings.handover_wait_ms) / 5;
+        startHandOverWatch();
+      }
     } else if (newcomer) {
       adopt_from_.erase(peer.node);
       known_at_return_.erase(peer.node);
+      handover_due_.erase(peer.node);
     }
     peers_[peer.node] = peer;
     had_mapping_peer_ = had_mapping_peer_ || peer.task == Task::Mapping;
@@ -422,15 +428,18 @@ void DistributedNode::keyframeMapped(const std::shared_ptr<core::Map>& map, cons
 }
 
 void DistributedNode::stop() {
-  std::thread finisher, releaser;
+  std::thread finisher, releaser, watch;
   {
     std::lock_guard lock(mutex_);
     stopping_ = true;
     finisher = std::move(finisher_);
     releaser = std::move(releaser_);
+    watch = std::move(handover_watch_);
   }
+  changed_.notify_all();
   if (finisher.joinable()) finisher.join();
   if (releaser.joinable()) releaser.join();
+  if (watch.joinable()) watch.join();
   gate_.stop();  // what is left goes out now: a peer that never matched is not waited for
   publisher_->finish();
   transport_.stop();

@@ -16,7 +16,8 @@
 // after TR took mapping back). Its keyframes of those maps wait for the snapshot. A peer back
 // from a partition (the incarnation whose lease ran out) is a newcomer too, but a tracking node
 // back from one is sent nothing: it kept its maps and mapped on alone, so the newer maps go from
-// it, not to it (docs/RELIABILITY.md).
+// it, not to it (docs/RELIABILITY.md). It hands them over only while it maps: an LC that hears
+// it back after LM took mapping asks the gateway for them (watchHandOvers).
 //
 // Slow link: a tracking node whose gateway acknowledges its keyframes too late (GatewayWatch)
 // releases its peers (Control::Release) and runs alone from then on, as the standalone system.
@@ -118,6 +119,12 @@ class DistributedNode final : public core::SystemEvents {
   void dropPendingGlobals(const communication::PeerInfo& peer);
   void applyPlan();
   void onGlobal(std::vector<MapRecord>&& batches, communication::Topic topic, uint16_t source);
+  // LC: runs watchHandOvers() on handover_watch_ unless it runs already; mutex_ held.
+  void startHandOverWatch();
+  // LC: a fifth of the hand-over wait after each tracking node's return from a partition, the
+  // maps it should have handed over here and has not are asked for from the gateway. Returns
+  // when no return is left to check, or the node stops.
+  void watchHandOvers();
   // The gateway: LC's update applied, then this node's state of the map relayed (LmMap).
   void applyLoopClosingUpdate(const std::vector<MapRecord>& batches);
   // The gateway: LC's update of a map that a tracking node back from a partition has yet to
@@ -200,7 +207,7 @@ class DistributedNode final : public core::SystemEvents {
   int local_maps_held_ = 0;  // local maps that came ahead of their global update
   uint64_t incarnation_ = 0;
   int maps_awaited_ = 0;  // keyframes that waited for a hand-over
-  int maps_asked_for_ = 0;  // of those, the ones whose map was asked for (Control::SendMap)
+  int maps_asked_for_ = 0;  // maps asked for (Control::SendMap): for waiting keyframes, or a missed hand-over
   int keyframes_taken_back_ = 0;  // unacknowledged keyframes mapped here after the LM left
   // TR: each acknowledged keyframe's round trip, in ms (sent to mapped, as TR saw it): what
   // decides how often TR may make a keyframe, and what a slow link stretches first.
@@ -228,6 +235,11 @@ class DistributedNode final : public core::SystemEvents {
   // LM, LC: the maps this node held when each of those tracking nodes came back: those it
   // hands over (a map made since comes as keyframes, not whole). Guarded by mutex_.
   std::map<uint16_t, std::set<core::Id>> known_at_return_;
+  // LC: when to check that each of them handed its maps over (watchHandOvers), by node; the
+  // thread that checks, and whether it runs. Guarded by mutex_.
+  std::map<uint16_t, std::chrono::steady_clock::time_point> handover_due_;
+  std::thread handover_watch_;
+  bool handover_watching_ = false;
   // The gateway: LC's latest update of each map held by holdForAdoption, and since when.
   // Guarded by mutex_.
   struct HeldUpdate {
