@@ -5,6 +5,7 @@
 #include <set>
 
 #include "common/thread_name.hpp"
+#include "core/map/follow_merges.hpp"
 #include "distribution/packet.hpp"
 #include "distribution/state_capture.hpp"
 
@@ -63,13 +64,8 @@ void KeyframePublisher::publish(const Job& job) {
   // now, in that map's frame, and goes out as that map's. Sent as the old map's, in a pose the
   // merge had moved, LM could not place it, and TR ended a run holding it alone. (Maps stay in
   // the atlas once merged: the pointers stay valid.)
-  core::Map* map = job.map->resolve();
-  std::unique_lock lock(map->mutex);
-  while (map->merged_into.load()) {
-    lock.unlock();
-    map = map->resolve();
-    lock = std::unique_lock(map->mutex);
-  }
+  core::Map* map = job.map.get();
+  auto lock = core::lockFollowingMerges(map);
   if (map != job.map.get()) maps_started_[map->id] = true;  // the receiver holds it already
   {
     const core::KeyFrame& kf = *job.keyframe;

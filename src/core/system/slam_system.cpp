@@ -8,6 +8,7 @@
 #include <unordered_set>
 
 #include "common/thread_name.hpp"
+#include "core/map/follow_merges.hpp"
 #include "core/mapping/keyframe_insertion.hpp"
 #include "core/optim/map_ba_problem.hpp"
 #include "core/optim/pose_optimizer.hpp"
@@ -352,26 +353,15 @@ const FrameRecord& SlamSystem::process(const cv::Mat& gray, double timestamp) {
 
 std::shared_ptr<Map> SlamSystem::insertOwnKeyframe(const std::shared_ptr<KeyFrame>& kf) {
   std::shared_ptr<Map> map = tracker_.map();
-  bool moved = false;
-  for (int hops = 0;; ++hops) {
-    std::unique_lock lock(map->mutex);
-    if (!map->merged_into.load() || hops == 8) {
-      // Merged since tracking posed it (another node's merge, applied here in between): it goes
-      // into the merged map, re-posed from the keyframe it was posed from, which the merge moved.
-      if (moved && kf->made_from) {
-        kf->T_cw = kf->made_from->poseOf(kf->made_pose);
-        kf->made_in_epoch = map->epoch;
-      }
-      insertKeyframe(*map, *kf, extractor_.scales(), &database_);
-      return map;
-    }
-    const Map* into = map->resolve();
-    lock.unlock();
-    if (auto next = findMap(into->id)) {
-      map = std::move(next);
-      moved = true;
-    }
+  const auto locked = lockFollowingMerges(map, [this](const Map* m) { return findMap(m->id); });
+  // Merged since tracking posed it (another node's merge, applied here in between): it goes
+  // into the merged map, re-posed from the keyframe it was posed from, which the merge moved.
+  if (locked.moved && kf->made_from) {
+    kf->T_cw = kf->made_from->poseOf(kf->made_pose);
+    kf->made_in_epoch = map->epoch;
   }
+  insertKeyframe(*map, *kf, extractor_.scales(), &database_);
+  return map;
 }
 
 void SlamSystem::dropCulledKeyframeImages() {

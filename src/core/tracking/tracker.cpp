@@ -8,6 +8,7 @@
 #include "core/features/hamming.hpp"
 #include "core/geometry/pnp_ransac.hpp"
 #include "core/geometry/two_view.hpp"
+#include "core/map/follow_merges.hpp"
 #include "core/mapping/keyframe_gap.hpp"
 #include "core/matching/bow_matcher.hpp"
 #include "core/matching/initial_matcher.hpp"
@@ -149,21 +150,13 @@ TrackingOutput Tracker::track(Frame frame, bool mapping_idle) {
 }
 
 std::unique_lock<std::mutex> Tracker::followMerges() {
-  std::unique_lock lock(map_->mutex);
   // Merged into another map since the last frame: a merge another node made, applied here,
   // need not keep the map tracking is in (LC's merge of TR's old map into its newer one came
   // just after TR had relocalized in the old one). Its keyframes and points live in the
   // other map now, and so does tracking; the merge moved them, so the last frame is re-posed.
-  for (int hops = 0; map_->merged_into.load() && map_finder_ && hops < 8; ++hops) {
-    const Map* into = map_->resolve();
-    lock.unlock();
-    if (auto next = map_finder_(into)) {
-      map_ = std::move(next);
-      epoch_seen_ = std::numeric_limits<uint64_t>::max();
-    }
-    lock = std::unique_lock(map_->mutex);
-  }
-  return lock;
+  auto locked = lockFollowingMerges(map_, map_finder_);
+  if (locked.moved) epoch_seen_ = std::numeric_limits<uint64_t>::max();
+  return std::move(locked.lock);
 }
 
 void Tracker::startInMap(const std::shared_ptr<Map>& map) {
