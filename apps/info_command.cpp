@@ -24,8 +24,9 @@ void addInfoCommand(CLI::App& app) {
   cmd->add_option("--times", *times, "Times file for image folders and videos");
   cmd->add_flag("--check", *check, "Read and decode every frame");
   cmd->add_flag("--image-stats", *stats,
-                "FAST corners per frame, their spread over an 8x6 grid, grey-level entropy and gradient (10th, 50th, "
-                "90th percentile over the frames)");
+                "FAST corners per frame, their spread over an 8x6 grid, weak corners in bare cells, grey-level entropy, "
+                "gradient and the share of features with a look-alike in the same image (10th, 50th, 90th percentile "
+                "over the frames)");
   cmd->add_option("--every", *every, "With --image-stats: every Nth frame")->capture_default_str()->check(CLI::Range(1, 100000));
   cmd->callback([=]() {
     io::DatasetOptions options;
@@ -45,7 +46,9 @@ void addInfoCommand(CLI::App& app) {
       const auto s = eval::summarizeStatistics(frames);
       fmt::print("image statistics over {} frames (10th / 50th / 90th percentile), at 640 pixels wide:\n", s.frames);
       for (const auto& [name, v] : {std::pair{"FAST corners", s.corners}, {"cells covered", s.cells_covered},
-                                    {"entropy bits", s.entropy_bits}, {"gradient", s.gradient}})
+                                    {"weak corners", s.weak_corners},
+                                    {"entropy bits", s.entropy_bits}, {"gradient", s.gradient},
+                                    {"look-alikes", s.look_alikes}})
         fmt::print("  {:<14} {:>8.2f} {:>8.2f} {:>8.2f}\n", name, v.p10, v.median, v.p90);
       return;
     }

@@ -56,6 +56,10 @@ void addSynthCommand(CLI::App& app) {
   cmd->add_option("--readout-ms", o->readout_ms, "With --realistic: rolling shutter readout, 0 for a global shutter (default 25)");
   cmd->add_option("--tremor-deg", o->tremor_deg, "With --realistic: the hand's tremor, 0 for none (default 0.3)");
   cmd->add_flag("!--exact-lens", o->lens_error, "With --realistic: the images made with the nominal lens of sensor.yaml");
+  cmd->add_option("--photo-max-look-alikes", o->photo_max_look_alikes,
+                  "With --textures: leave out photos whose features repeat more than this share, 0-1 (default 0.35 "
+                  "with --realistic, the most repetitive real frames; otherwise 1, every photo)")
+      ->check(CLI::Range(0.0, 1.0));
   cmd->add_option("--threads", o->threads, "Render threads (0: all cores)")->capture_default_str();
   cmd->add_option("--suite", *suite_name, "Render a named suite instead (standard | realistic)");
   cmd->add_option("--out", *out, "Output folder")->required();

@@ -5,6 +5,8 @@
 #include <opencv2/features2d.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "common/look_alike_share.hpp"
+
 namespace hiveslam::eval {
 
 ImageStatistics imageStatistics(const cv::Mat& gray_in) {
@@ -22,6 +24,16 @@ ImageStatistics imageStatistics(const cv::Mat& gray_in) {
   int n = 0;
   for (const auto& row : covered) n += static_cast<int>(std::count(std::begin(row), std::end(row), true));
   s.cells_covered = static_cast<double>(n) / (kRows * kCols);
+  constexpr int kCell = 32;
+  const int cell_cols = (gray.cols + kCell - 1) / kCell;
+  std::vector<uint8_t> strong(static_cast<size_t>(cell_cols * ((gray.rows + kCell - 1) / kCell)), 0);
+  auto cell = [&](const cv::KeyPoint& k) {
+    return static_cast<size_t>(static_cast<int>(k.pt.y) / kCell * cell_cols + static_cast<int>(k.pt.x) / kCell);
+  };
+  for (const auto& k : corners) strong[cell(k)] = 1;
+  std::vector<cv::KeyPoint> weak;
+  cv::FAST(gray, weak, 7, true);
+  s.weak_corners = static_cast<double>(std::count_if(weak.begin(), weak.end(), [&](const cv::KeyPoint& k) { return !strong[cell(k)]; }));
   std::vector<double> histogram(256, 0.0);
   for (int y = 0; y < gray.rows; ++y)
     for (int x = 0; x < gray.cols; ++x) histogram[gray.at<uchar>(y, x)] += 1;
@@ -35,6 +47,7 @@ ImageStatistics imageStatistics(const cv::Mat& gray_in) {
   // Sobel's 3x3 derivative of a ramp of one grey level per pixel is 8: divided, a gradient in
   // grey levels per pixel.
   s.gradient = cv::mean(magnitude)[0] / 8.0;
+  s.look_alikes = lookAlikeShare(gray);
   return s;
 }
 
@@ -52,17 +65,21 @@ Spread spreadOf(std::vector<double> v) {
 SequenceStatistics summarizeStatistics(const std::vector<ImageStatistics>& frames) {
   SequenceStatistics s;
   s.frames = frames.size();
-  std::vector<double> c, cells, e, g;
+  std::vector<double> c, cells, w, e, g, l;
   for (const auto& f : frames) {
     c.push_back(f.corners);
     cells.push_back(f.cells_covered);
+    w.push_back(f.weak_corners);
     e.push_back(f.entropy_bits);
     g.push_back(f.gradient);
+    l.push_back(f.look_alikes);
   }
   s.corners = spreadOf(c);
   s.cells_covered = spreadOf(cells);
+  s.weak_corners = spreadOf(w);
   s.entropy_bits = spreadOf(e);
   s.gradient = spreadOf(g);
+  s.look_alikes = spreadOf(l);
   return s;
 }
 

@@ -23,6 +23,11 @@ namespace {
 
 constexpr int64_t kStartNs = 1'000'000'000'000;  // 1000 s: EuRoC-like stamps, exact in ns
 
+double photoMaxLookAlikes(const SequenceOptions& o) {
+  if (o.photo_max_look_alikes >= 0) return o.photo_max_look_alikes;
+  return o.realistic ? 0.35 : 1.0;
+}
+
 Eigen::Vector3d roomSize(std::mt19937_64& rng, bool furnished) {
   auto uni = [&](double a, double b) { return std::uniform_real_distribution<double>(a, b)(rng); };
   // A furnished room is an office or a living room; the textured box room is a hall.
@@ -41,7 +46,7 @@ SequenceModel buildSequence(const SequenceOptions& o) {
   SceneOptions scene_options;
   scene_options.room_size = roomSize(layout_rng, o.realistic);
   scene_options.furnished = o.realistic;
-  if (!o.textures.empty()) scene_options.photos = loadPhotos(o.textures);
+  if (!o.textures.empty()) scene_options.photos = loadPhotos(o.textures, photoMaxLookAlikes(o));
   TrajectoryPlan plan = planTrajectory(o.trajectory, scene_options.room_size, path_rng);
   const double duration = (o.frames - 1) / o.fps;
   CameraPath path(plan.waypoints, duration, 0.03, static_cast<unsigned>(o.seed));
@@ -233,6 +238,7 @@ SequenceSummary writeSequence(const SequenceOptions& o, const fs::path& out,
                          {"tremor_deg", o.tremor_deg},
                          {"lens_error", o.lens_error},
                          {"textures", o.textures.empty() ? "procedural" : o.textures},
+                         {"photo_max_look_alikes", photoMaxLookAlikes(o)},
                          {"room_size", {model.scene.room_max.x() * 2, model.scene.room_max.y() * 2, model.scene.room_max.z()}},
                          {"boxes", model.scene.boxes.size()},
                          {"pillars", model.scene.pillars.size()},
@@ -267,6 +273,7 @@ SequenceOptions readSequenceOptions(const fs::path& dataset) {
     o.lens_error = info.value("lens_error", true);
     const auto textures = info.at("textures").get<std::string>();
     if (textures != "procedural") o.textures = textures;
+    o.photo_max_look_alikes = info.value("photo_max_look_alikes", 1.0);  // written before: every photo
     return o;
   } catch (const nlohmann::json::exception& e) {
     throw InputError(file.string() + ": not what hiveslam synth writes (" + e.what() + ")");

@@ -34,6 +34,11 @@ struct SequenceOptions {
   // Ablations of the realistic camera (negative: Imaging::realistic()'s value).
   double exposure_ms = -1, readout_ms = -1, tremor_deg = -1;
   bool lens_error = true;        // false: the true lens is the nominal one
+  // Photos that repeat themselves more than this are not used as textures (loadPhotos).
+  // Negative: realistic renders keep photos up to 0.35, the look-alike share of the most
+  // repetitive tenth of real frames (phone_room_droidcam's keyboard; KITTI's median frame is at
+  // 0.05), and the others keep every photo.
+  double photo_max_look_alikes = -1;
   int threads = 0;               // 0: all cores
 };
 

@@ -1,5 +1,7 @@
 #include "synth/texture.hpp"
 
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
@@ -7,6 +9,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "common/error.hpp"
+#include "common/look_alike_share.hpp"
 
 namespace hiveslam::synth {
 
@@ -195,7 +198,7 @@ Texture makePlainTexture(double width_m, double height_m, double density, double
   return Texture(img, density);
 }
 
-std::vector<cv::Mat> loadPhotos(const std::string& folder) {
+std::vector<cv::Mat> loadPhotos(const std::string& folder, double max_look_alikes) {
   namespace fs = std::filesystem;
   if (!fs::is_directory(folder)) throw InputError("texture folder not found: " + folder);
   std::vector<fs::path> files;
@@ -208,9 +211,17 @@ std::vector<cv::Mat> loadPhotos(const std::string& folder) {
   std::vector<cv::Mat> photos;
   for (const auto& f : files) {
     cv::Mat m = cv::imread(f.string(), cv::IMREAD_GRAYSCALE);
-    if (!m.empty() && m.cols >= 64 && m.rows >= 64) photos.push_back(m);
+    if (m.empty() || m.cols < 64 || m.rows < 64) continue;
+    if (max_look_alikes < 1.0) {
+      cv::Mat at640;
+      cv::resize(m, at640, {}, 640.0 / m.cols, 640.0 / m.cols, cv::INTER_AREA);
+      if (lookAlikeShare(at640) > max_look_alikes) continue;
+    }
+    photos.push_back(m);
   }
-  if (photos.empty()) throw InputError("no usable photos (jpg/png, at least 64x64) in " + folder);
+  if (photos.empty())
+    throw InputError(fmt::format("no usable photos (jpg/png, at least 64x64, look-alike share at most {}) in {}",
+                                 max_look_alikes, folder));
   return photos;
 }
 

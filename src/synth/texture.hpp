@@ -43,7 +43,10 @@ Texture makePhotoTexture(double width_m, double height_m, double density,
 // (scuffs, screw heads, an outline), so that large parts of it hold no corner at all.
 Texture makePlainTexture(double width_m, double height_m, double density, double grey, std::mt19937_64& rng);
 
-// Loads the images of a folder as grayscale photos (throws InputError when there are none).
-std::vector<cv::Mat> loadPhotos(const std::string& folder);
+// Loads the images of a folder as grayscale photos (throws InputError when there are none),
+// leaving out those that repeat themselves more than `max_look_alikes` (common/look_alike_share.hpp,
+// measured at 640 pixels wide): calibration chessboards, logos and drawn shapes, which no real
+// room is papered with.
+std::vector<cv::Mat> loadPhotos(const std::string& folder, double max_look_alikes = 1.0);
 
 }  // namespace hiveslam::synth

@@ -5,11 +5,13 @@
 #include <opencv2/imgproc.hpp>
 
 #include "common/error.hpp"
+#include "common/look_alike_share.hpp"
 #include "io/open_dataset.hpp"
 #include <opencv2/imgcodecs.hpp>
 #include "synth/renderer.hpp"
 #include "synth/sequence.hpp"
 #include "synth/suite.hpp"
+#include "synth/texture.hpp"
 #include "temp_dir.hpp"
 #include "warp_error.hpp"
 
@@ -129,6 +131,30 @@ TEST(Sequence, TexturesFromPhotos) {
   EXPECT_GT(stddev[0], 10.0);  // textured, not blank
   o.textures = (dir / "missing").string();
   EXPECT_THROW(buildSequence(o), InputError);
+}
+
+// A calibration chessboard repeats one corner everywhere; smoothed noise, like fur or foliage,
+// does not. The realistic suite's default leaves the first out of its textures.
+TEST(Sequence, PhotosThatRepeatThemselvesAreLeftOut) {
+  testing::TempDir dir;
+  std::filesystem::create_directories(dir / "photos");
+  cv::Mat board(480, 640, CV_8U);
+  for (int y = 0; y < board.rows; ++y)
+    for (int x = 0; x < board.cols; ++x) board.at<uchar>(y, x) = ((x / 40 + y / 40) % 2) ? 220 : 30;
+  cv::Mat noise(480, 640, CV_32F), blobs;
+  cv::RNG(3).fill(noise, cv::RNG::NORMAL, 0, 1);
+  cv::GaussianBlur(noise, noise, {0, 0}, 2.0);
+  cv::normalize(noise, blobs, 0, 255, cv::NORM_MINMAX, CV_8U);
+  EXPECT_GT(lookAlikeShare(board), 0.8);
+  EXPECT_LT(lookAlikeShare(blobs), 0.2);
+  cv::imwrite((dir / "photos" / "board.png").string(), board);
+  cv::imwrite((dir / "photos" / "blobs.png").string(), blobs);
+  EXPECT_EQ(loadPhotos((dir / "photos").string()).size(), 2u);
+  const auto kept = loadPhotos((dir / "photos").string(), 0.35);
+  ASSERT_EQ(kept.size(), 1u);
+  EXPECT_EQ(cv::norm(kept[0], blobs, cv::NORM_INF), 0);
+  std::filesystem::remove(dir / "photos" / "blobs.png");
+  EXPECT_THROW(loadPhotos((dir / "photos").string(), 0.35), InputError);
 }
 
 TEST(Sequence, WritesEurocLayout) {
