@@ -31,7 +31,16 @@ void LiveView::setFrame(const std::string& node, LiveFrame frame, bool extend_pa
   std::lock_guard lock(mutex_);
   NodeState& n = nodes_[node];
   const bool was_tracked = n.frame && n.frame->tracked;
-  if (frame.tracked && extend_path) n.path.push_back({frame.timestamp, frame.map, frame.T_wc});
+  if (frame.tracked && extend_path) {
+    n.path.push_back({frame.timestamp, frame.map, frame.T_wc});
+    if (n.path.size() > kMaxPathPoses) {
+      size_t kept = 0;
+      for (size_t i = 0; i < n.path.size(); i += 2) n.path[kept++] = n.path[i];
+      if (n.path.size() % 2 == 0) n.path[kept++] = n.path.back();
+      n.path.resize(kept);
+      ++n.path_epoch;
+    }
+  }
   if (was_tracked && !frame.tracked) pushEvent(n, now, fmt::format("tracking lost at frame {}", frame.index));
   n.frame = std::move(frame);
   ++n.frame_version;

@@ -43,6 +43,11 @@ struct NodeState {
 class LiveView {
  public:
   static constexpr size_t kKeptEvents = 50;
+  // A path longer than this is thinned to every second pose (the first and the newest kept) and
+  // sent again (path_epoch): a node that runs for hours holds and draws a bounded path, under
+  // 2.5 MB with the vector's spare room, where every frame's pose would add 144 bytes (0.17 MB a
+  // minute at 20 Hz; a 30-minute soak's TR grew by 0.8 MB a minute in all).
+  static constexpr size_t kMaxPathPoses = 10000;
   LiveView();
   // A tracked frame extends the node's path (unless the path comes from elsewhere:
   // extend_path false); a frame lost after a tracked one is an event.

@@ -41,6 +41,35 @@ TEST(LiveView, TrackedFramesMakeThePathAndALossIsAnEvent) {
   v.read([](const std::map<std::string, NodeState>& nodes) { EXPECT_TRUE(nodes.at("view-of-tr").path.empty()); });
 }
 
+// A node that runs for hours keeps a bounded path: past the cap it is thinned to every second
+// pose, the first and the newest kept, and sent again whole (path_epoch).
+TEST(LiveView, ALongRunsPathIsThinnedNotGrown) {
+  LiveView v;
+  const size_t frames = 5 * LiveView::kMaxPathPoses + 7;
+  size_t most = 0, resets = 0;
+  uint64_t epoch = 0;
+  for (size_t i = 0; i < frames; ++i) {
+    v.setFrame("tr", frame(i, true));
+    v.read([&](const std::map<std::string, NodeState>& nodes) {
+      const NodeState& n = nodes.at("tr");
+      most = std::max(most, n.path.size());
+      if (n.path_epoch != epoch) {
+        ++resets;
+        epoch = n.path_epoch;
+      }
+    });
+  }
+  EXPECT_EQ(most, LiveView::kMaxPathPoses);
+  EXPECT_GE(resets, 4u);
+  v.read([&](const std::map<std::string, NodeState>& nodes) {
+    const auto& path = nodes.at("tr").path;
+    EXPECT_GT(path.size(), LiveView::kMaxPathPoses / 2);
+    EXPECT_EQ(path.front().timestamp, frame(0, true).timestamp);
+    EXPECT_EQ(path.back().timestamp, frame(frames - 1, true).timestamp);
+    for (size_t i = 1; i < path.size(); ++i) ASSERT_LT(path[i - 1].timestamp, path[i].timestamp) << i;
+  });
+}
+
 TEST(LiveView, PanelChangesBecomeEvents) {
   const nlohmann::json a = {{"peers", 1}, {"tasks", {"tr", "lm"}}, {"loops", 0}, {"merges", 0}, {"maps_made", 1}};
   nlohmann::json b = a;
