@@ -2,13 +2,18 @@
 
 #include <fmt/format.h>
 
+#include <fmt/ranges.h>
+
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <map>
 #include <mutex>
 #include <optional>
 
 #include "core/camera/pinhole_radtan.hpp"
+#include "core/features/hamming.hpp"
+#include "core/features/look_alikes.hpp"
 #include "core/map/map.hpp"
 #include "core/map/map_point.hpp"
 #include "core/system/slam_system.hpp"
@@ -108,6 +113,14 @@ class MatchProbe : public core::SystemEvents {
       });
       weak_points_ += weak;
       weak_wrong_ += weak && joins_two;
+      if (p->observations.size() == 2) {
+        const auto a = *p->observations.begin(), b = *std::next(p->observations.begin());
+        const int d = features::hamming(a.first->frame.descriptors.ptr<uchar>(a.second), b.first->frame.descriptors.ptr<uchar>(b.second));
+        ++distances_[weak][joins_two][std::min(d / 10, 5)];
+        const int nn = std::min(selfNearest(*a.first, a.second), selfNearest(*b.first, b.second));
+        const double r = nn > 0 ? static_cast<double>(d) / nn : 9.0;
+        ++ratios_[weak][joins_two][std::min(static_cast<int>(r / 0.2), 6)];
+      }
     }
     new_points_ += made;
     new_wrong_ += wrong;
@@ -213,6 +226,12 @@ class MatchProbe : public core::SystemEvents {
     fmt::print("\nnew points: {}, {:.1f}% joining two scene points; tracking inliers: {}, {:.1f}% joined to another scene point\n",
                new_points_, new_points_ ? 100.0 * new_wrong_ / new_points_ : 0.0, matches,
                matches ? 100.0 * static_cast<double>(wrong) / static_cast<double>(matches) : 0.0);
+    fmt::print("new points by the distance of their two descriptors (0-9, 10-19, 20-29, 30-39, 40-49, 50+) | by that "
+               "distance over the nearer look-alike's in either image (under 0.2, 0.4, 0.6, 0.8, 1.0, 1.2, more):\n");
+    for (int weak : {0, 1})
+      for (int wrong : {0, 1})
+        fmt::print("  {:6} {:5}: {:>5} | {:>5}\n", weak ? "weak" : "strong", wrong ? "wrong" : "right",
+                   fmt::join(distances_[weak][wrong], " "), fmt::join(ratios_[weak][wrong], " "));
     fmt::print("new points with a keypoint found only at the detector's lower threshold: {} ({:.1f}%), {:.1f}% of them joining two scene points; the others {:.1f}%\n",
                weak_points_, new_points_ ? 100.0 * weak_points_ / new_points_ : 0.0,
                weak_points_ ? 100.0 * weak_wrong_ / weak_points_ : 0.0,
@@ -259,6 +278,15 @@ class MatchProbe : public core::SystemEvents {
   std::map<core::Id, std::pair<int, int>> pending_;
   std::map<int, Second> seconds_;
   int new_points_ = 0, new_wrong_ = 0, keyframes_ = 0, weak_points_ = 0, weak_wrong_ = 0;
+  std::array<std::array<std::array<int, 6>, 2>, 2> distances_{};
+  std::array<std::array<std::array<int, 7>, 2>, 2> ratios_{};
+  std::map<core::Id, std::vector<uint8_t>> self_nn_;
+  // A keypoint's nearest look-alike in its own keyframe, computed once per keyframe.
+  int selfNearest(const core::KeyFrame& kf, int i) {
+    auto& v = self_nn_[kf.id];
+    if (v.empty()) v = features::lookAlikeDistances(kf.frame.keypoints, kf.frame.descriptors);
+    return v[static_cast<size_t>(i)];
+  }
   float fast_threshold_ = 0;
   double misplaced_sum_ = 0;
   std::shared_ptr<const camera::CameraModel> camera_;

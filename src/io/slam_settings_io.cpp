@@ -60,6 +60,7 @@ KeyTable slamKeys(core::SlamSettings& s) {
       {"triangulation_neighbours", set(s.triangulation_neighbours)},
       {"triangulation_max_cos_parallax", set(s.triangulation_max_cos_parallax)},
       {"triangulation_by_vocabulary", set(s.triangulation_by_vocabulary)},
+      {"triangulation_look_alike_ratio", set(s.triangulation_look_alike_ratio)},
       {"fusion_neighbours", set(s.fusion_neighbours)},
       {"local_ba_iterations", set(s.local_ba_iterations)},
       {"keyframe_queue", set(s.keyframe_queue)},

@@ -4,6 +4,7 @@
 
 #include "core/features/brief_pattern.hpp"
 #include "core/features/hamming.hpp"
+#include "core/features/look_alikes.hpp"
 #include "core/features/orb_extractor.hpp"
 #include "synth/renderer.hpp"
 #include "synth/sequence.hpp"
@@ -186,6 +187,33 @@ TEST(OrbExtractor, SubPixelCornersMeetTheirTrueProjections) {
   EXPECT_GT(median_pixel, 0.35);  // the rounding the test must see to mean anything
   EXPECT_LT(median_sub, 0.15);
   EXPECT_LT(rms_sub, 0.6 * rms_pixel) << rms_sub << " vs " << rms_pixel;
+}
+
+// The corners of a chessboard are one corner repeated: each has a twin a few bits away. The
+// corners of a rendered room (figure8's procedural texture) mostly do not. Keypoints nearer
+// than 16 pixels (one corner at two pyramid levels) are not each other's look-alikes.
+TEST(LookAlikes, ARepeatedPatternHasTwinsARandomOneDoesNot) {
+  cv::Mat board(480, 640, CV_8U);
+  for (int y = 0; y < board.rows; ++y)
+    for (int x = 0; x < board.cols; ++x) board.at<uchar>(y, x) = ((x / 40 + y / 40) % 2) ? 220 : 30;
+  cv::GaussianBlur(board, board, {0, 0}, 1.0);
+  const Extracted b = extractDefault(board), r = extractDefault(renderedImage());
+  auto median = [](std::vector<uint8_t> v) {
+    std::nth_element(v.begin(), v.begin() + static_cast<long>(v.size() / 2), v.end());
+    return static_cast<int>(v[v.size() / 2]);
+  };
+  const auto board_twins = lookAlikeDistances(b.keypoints, b.descriptors);
+  const auto room_twins = lookAlikeDistances(r.keypoints, r.descriptors);
+  ASSERT_EQ(board_twins.size(), b.keypoints.size());
+  ASSERT_GT(b.keypoints.size(), 50u);
+  EXPECT_LT(median(board_twins), 10) << median(board_twins);
+  EXPECT_GT(median(room_twins), 25) << median(room_twins);
+
+  std::vector<cv::KeyPoint> two{cv::KeyPoint(100, 100, 31), cv::KeyPoint(110, 100, 31)};
+  cv::Mat same(2, 32, CV_8U, cv::Scalar(7));
+  EXPECT_EQ(lookAlikeDistances(two, same), (std::vector<uint8_t>{255, 255}));  // 10 px apart
+  two[1].pt.x = 130;
+  EXPECT_EQ(lookAlikeDistances(two, same), (std::vector<uint8_t>{0, 0}));
 }
 
 TEST(OrbExtractor, DeterministicAndCheapOnBlankImages) {

@@ -43,6 +43,10 @@ class KeyFrame : public std::enable_shared_from_this<KeyFrame> {
   // Bag of words of the image, set before the keyframe is shared and never changed after.
   place::BowVector bow;
   place::FeatureVector bow_features;
+  // Per keypoint, the distance to its nearest look-alike in this image
+  // (core/features/look_alikes.hpp): filled by local mapping, under the map's lock, when it first
+  // triangulates with this keyframe.
+  std::vector<uint8_t> look_alikes;
   // Loop and merge links: kept by the essential graph, and never culled.
   std::set<KeyFrame*, ById> loop_edges;
 

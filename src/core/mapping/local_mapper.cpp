@@ -7,6 +7,7 @@
 #include <set>
 
 #include "core/features/hamming.hpp"
+#include "core/features/look_alikes.hpp"
 #include "core/features/rotation_histogram.hpp"
 #include "core/geometry/skew.hpp"
 #include "core/geometry/triangulation.hpp"
@@ -154,9 +155,18 @@ void LocalMapper::triangulateNewPoints(Map& map, KeyFrame& kf) {
     if ((nb->center() - C1).norm() / depths[depths.size() / 2] < 0.01) continue;
 
     const Eigen::Isometry3d T21 = nb->T_cw * T1w.inverse();  // kf frame -> neighbour frame
+    const double look_alike_ratio = settings_.triangulation_look_alike_ratio;
+    if (look_alike_ratio > 0) {
+      for (KeyFrame* k : {&kf, nb})
+        if (k->look_alikes.empty()) k->look_alikes = features::lookAlikeDistances(k->frame.keypoints, k->frame.descriptors);
+    }
     for (const auto& [ii, best_j] : epipolarPairs(kf, *nb, T21)) {
       const size_t i = static_cast<size_t>(ii);
       const size_t j = static_cast<size_t>(best_j);
+      if (look_alike_ratio > 0) {
+        const int d = features::hamming(kf.frame.descriptors.ptr<uchar>(ii), nb->frame.descriptors.ptr<uchar>(best_j));
+        if (d >= look_alike_ratio * std::min(kf.look_alikes[i], nb->look_alikes[j])) continue;
+      }
       const double s1 = scales_[static_cast<size_t>(kf.frame.keypoints[i].octave)];
       const double s2 = scales_[static_cast<size_t>(nb->frame.keypoints[j].octave)];
       TriangulationCheck check{std::sqrt(5.991) * std::max(s1, s2), settings_.triangulation_max_cos_parallax};

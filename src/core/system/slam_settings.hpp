@@ -57,6 +57,11 @@ struct SlamSettings {
   // bench the 3-node outlier rule failed on three sequences (one TR lost figure8's fast turn,
   // short of points) where it had held on all four: off until two benches say otherwise.
   bool triangulation_by_vocabulary = false;
+  // A new point's two keypoints must be closer in descriptor than this share of the nearer of
+  // their look-alikes, the most similar other keypoint in either's own image
+  // (core/features/look_alikes.hpp); 0: no such check. Keypoints on smooth shading or in a
+  // repeated pattern have twins a few bits away, and a match no better than the twin is a guess.
+  double triangulation_look_alike_ratio = 0;
   int fusion_neighbours = 10;
   int local_ba_iterations = 10;
   // Keyframes that may wait for local mapping while it works on an earlier one (0: a keyframe is
