@@ -253,6 +253,8 @@ void addEvalCommand(CLI::App& app) {
   matches_cmd->footer("Example:\n  hiveslam eval matches seq/handheld1 --frames 300 --sharp");
   matches_cmd->add_option("DATASET", *matches_dataset, "A sequence written by hiveslam synth (its sequence.json)")->required();
   matches_cmd->add_option("--frames", matches_options->frames, "Only the first N frames")->check(CLI::Range(1, 1000000));
+  matches_cmd->add_flag("--true-lens", matches_options->true_lens,
+                         "Give the SLAM the calibration the images were rendered with (a realistic render's nominal one is off)");
   matches_cmd->add_flag("--sharp", matches_options->sharp,
                         "Render without motion blur, rolling shutter, hand tremor and lens error");
   matches_cmd->add_option("--config", *matches_config, "Settings YAML (its slam section)");

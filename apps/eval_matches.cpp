@@ -11,9 +11,10 @@
 #include <mutex>
 #include <optional>
 
+#include "common/look_alikes.hpp"
 #include "core/camera/pinhole_radtan.hpp"
 #include "core/features/hamming.hpp"
-#include "core/features/look_alikes.hpp"
+#include "core/features/orb_extractor.hpp"
 #include "core/map/map.hpp"
 #include "core/map/map_point.hpp"
 #include "core/system/slam_system.hpp"
@@ -83,7 +84,7 @@ double scaleOf(int octave) { return std::pow(1.2, octave); }
 
 class MatchProbe : public core::SystemEvents {
  public:
-  MatchProbe(const SceneOracle& oracle, float fast_threshold) : oracle_(oracle), fast_threshold_(fast_threshold) {}
+  explicit MatchProbe(const SceneOracle& oracle) : oracle_(oracle) {}
 
   void mapCreated(const std::shared_ptr<core::Map>& map) override {
     std::lock_guard l(mutex_);
@@ -106,10 +107,8 @@ class MatchProbe : public core::SystemEvents {
       ++made;
       const bool joins_two = seesAnotherPoint(*p, *X, kf->frame.keypoints[i].octave);
       wrong += joins_two;
-      // Found only at the detector's lower threshold (a corner weaker than fast_threshold): on
-      // plain walls these are the image noise's.
       const bool weak = std::any_of(p->observations.begin(), p->observations.end(), [&](const auto& o) {
-        return o.first->frame.keypoints[static_cast<size_t>(o.second)].response < fast_threshold_;
+        return features::isWeakCorner(o.first->frame.keypoints[static_cast<size_t>(o.second)]);
       });
       weak_points_ += weak;
       weak_wrong_ += weak && joins_two;
@@ -284,10 +283,9 @@ class MatchProbe : public core::SystemEvents {
   // A keypoint's nearest look-alike in its own keyframe, computed once per keyframe.
   int selfNearest(const core::KeyFrame& kf, int i) {
     auto& v = self_nn_[kf.id];
-    if (v.empty()) v = features::lookAlikeDistances(kf.frame.keypoints, kf.frame.descriptors);
+    if (v.empty()) v = lookAlikeDistances(kf.frame.keypoints, kf.frame.descriptors);
     return v[static_cast<size_t>(i)];
   }
-  float fast_threshold_ = 0;
   double misplaced_sum_ = 0;
   std::shared_ptr<const camera::CameraModel> camera_;
   core::Intrinsics K_;
@@ -306,11 +304,11 @@ void evalMatches(const std::string& dataset, const core::SlamSettings& settings,
   }
   const auto model = synth::buildSequence(o);
   const synth::RayTable rays(model.true_lens);
-  const synth::Lens& L = model.lens;
+  const synth::Lens& L = options.true_lens ? model.true_lens : model.lens;
   auto camera = std::make_shared<camera::PinholeRadTan>(L.width, L.height, L.fx, L.fy, L.cx, L.cy,
                                                         std::vector<double>(L.k.begin(), L.k.end()));
   SceneOracle oracle(model);
-  MatchProbe probe(oracle, static_cast<float>(settings.orb.fast_threshold));
+  MatchProbe probe(oracle);
   core::SlamSettings s = settings;
   s.refine_frames = true;  // the frames' inliers
   core::SlamSystem slam(s, camera, core::SlamSystem::Mode::Sequential);
@@ -320,7 +318,8 @@ void evalMatches(const std::string& dataset, const core::SlamSettings& settings,
   slam.setFrameListener([&](const core::FrameRecord& r, const Eigen::Isometry3d& T_cw, const std::vector<cv::KeyPoint>&,
                             const cv::Mat&) { probe.frame(r, T_cw, slam.findMap(r.map)); });
   const int frames = options.frames > 0 ? std::min(options.frames, o.frames) : o.frames;
-  fmt::print("{}: {} frames{}, sequential\n", dataset, frames, options.sharp ? ", sharp (no blur, rolling shutter, tremor or lens error)" : "");
+  fmt::print("{}: {} frames{}{}, sequential\n", dataset, frames, options.sharp ? ", sharp (no blur, rolling shutter, tremor or lens error)" : "",
+             options.true_lens ? ", true lens" : "");
   for (int f = 0; f < frames; ++f) slam.process(model.renderImage(f, rays), model.stamp(f));
   slam.finish();
   probe.summary();

@@ -10,6 +10,7 @@ namespace hiveslam::apps {
 struct MatchesOptions {
   int frames = 0;      // 0: all
   bool sharp = false;  // render without motion blur, rolling shutter, tremor and lens error
+  bool true_lens = false;  // give the SLAM the lens the images were rendered with, not the nominal one
 };
 
 // Runs the sequential SLAM on a sequence written by `hiveslam synth` (rebuilt from its

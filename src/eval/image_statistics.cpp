@@ -5,7 +5,7 @@
 #include <opencv2/features2d.hpp>
 #include <opencv2/imgproc.hpp>
 
-#include "common/look_alike_share.hpp"
+#include "common/look_alikes.hpp"
 
 namespace hiveslam::eval {
 

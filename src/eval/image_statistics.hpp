@@ -4,7 +4,7 @@
 // scaled to 640 pixels wide so that sizes compare), how they spread over an 8x6 grid (the share
 // of cells holding one), weak corners (FAST at threshold 7 in the 32-pixel cells that hold none at
 // 20: what ORB-SLAM's extractor, and ours, take when a cell is bare), the grey-level entropy, the
-// mean gradient magnitude, and how much of the image repeats itself (common/look_alike_share.hpp).
+// mean gradient magnitude, and how much of the image repeats itself (common/look_alikes.hpp).
 #include <opencv2/core.hpp>
 #include <string>
 #include <vector>

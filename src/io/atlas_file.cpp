@@ -7,6 +7,7 @@
 #include <unordered_set>
 
 #include "common/error.hpp"
+#include "core/features/orb_extractor.hpp"
 
 namespace hiveslam::io {
 
@@ -118,7 +119,7 @@ void saveAtlas(const std::filesystem::path& file, const std::vector<std::shared_
       for (size_t i = 0; i < f.keypoints.size(); ++i) {
         const cv::KeyPoint& k = f.keypoints[i];
         for (float x : {k.pt.x, k.pt.y, k.size, k.angle, k.response}) w.put(x);
-        w.put(static_cast<int32_t>(k.octave));
+        w.put(static_cast<int32_t>(k.octave | (features::isWeakCorner(k) ? 0x100 : 0)));  // weak flag above the level
         w.put(f.points[i].x());
         w.put(f.points[i].y());
         w.bytes(f.descriptors.ptr<uint8_t>(static_cast<int>(i)), 32);
@@ -197,8 +198,10 @@ std::vector<std::shared_ptr<core::Map>> loadAtlas(const std::filesystem::path& f
         kp.size = r.get<float>();
         kp.angle = r.get<float>();
         kp.response = r.get<float>();
-        kp.octave = r.get<int32_t>();
-        if (kp.octave < 0 || kp.octave > 31) r.corrupt("keypoint level");
+        const auto level = r.get<int32_t>();
+        kp.octave = level & 0xff;
+        kp.class_id = (level & 0x100) ? features::kWeakCorner : -1;
+        if ((level & ~0x1ff) != 0 || kp.octave > 31) r.corrupt("keypoint level");
         f.keypoints.push_back(kp);
         const double x = r.finite("keypoint"), y = r.finite("keypoint");
         f.points.emplace_back(x, y);

@@ -9,7 +9,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "common/error.hpp"
-#include "common/look_alike_share.hpp"
+#include "common/look_alikes.hpp"
 
 namespace hiveslam::synth {
 

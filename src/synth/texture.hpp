@@ -44,7 +44,7 @@ Texture makePhotoTexture(double width_m, double height_m, double density,
 Texture makePlainTexture(double width_m, double height_m, double density, double grey, std::mt19937_64& rng);
 
 // Loads the images of a folder as grayscale photos (throws InputError when there are none),
-// leaving out those that repeat themselves more than `max_look_alikes` (common/look_alike_share.hpp,
+// leaving out those that repeat themselves more than `max_look_alikes` (common/look_alikes.hpp,
 // measured at 640 pixels wide): calibration chessboards, logos and drawn shapes, which no real
 // room is papered with.
 std::vector<cv::Mat> loadPhotos(const std::string& folder, double max_look_alikes = 1.0);

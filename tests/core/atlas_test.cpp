@@ -8,6 +8,7 @@
 
 #include "common/error.hpp"
 #include "core/camera/pinhole_radtan.hpp"
+#include "core/features/orb_extractor.hpp"
 #include "core/system/slam_system.hpp"
 #include "io/atlas_file.hpp"
 #include "synth/sequence.hpp"
@@ -54,6 +55,7 @@ TEST(Atlas, SaveThenLoadGivesAnIdenticalMap) {
   io::saveAtlas(dir.path() / "a.atlas", maps);
   const auto loaded = io::loadAtlas(dir.path() / "a.atlas");
   ASSERT_EQ(loaded.size(), maps.size());
+  int weak = 0;
   for (size_t m = 0; m < maps.size(); ++m) {
     const Map& a = *maps[m];
     const Map& b = *loaded[m];
@@ -71,6 +73,8 @@ TEST(Atlas, SaveThenLoadGivesAnIdenticalMap) {
       for (size_t i = 0; i < ka->frame.size(); ++i) {
         EXPECT_EQ(ka->frame.points[i], kb.frame.points[i]);
         EXPECT_EQ(ka->frame.keypoints[i].octave, kb.frame.keypoints[i].octave);
+        EXPECT_EQ(features::isWeakCorner(ka->frame.keypoints[i]), features::isWeakCorner(kb.frame.keypoints[i]));
+        weak += features::isWeakCorner(ka->frame.keypoints[i]);
         EXPECT_EQ(ka->points[i] ? ka->points[i]->id : kNoId, kb.points[i] ? kb.points[i]->id : kNoId);
       }
       EXPECT_EQ(ka->parent ? ka->parent->id : kNoId, kb.parent ? kb.parent->id : kNoId);
@@ -89,6 +93,7 @@ TEST(Atlas, SaveThenLoadGivesAnIdenticalMap) {
       EXPECT_EQ(cv::norm(pa->descriptor, pb.descriptor, cv::NORM_HAMMING), 0);
     }
   }
+  EXPECT_GT(weak, 0) << "the sweep's keyframes hold weak corners, whose flag must survive";
   // Saving the loaded atlas again writes the same bytes.
   io::saveAtlas(dir.path() / "b.atlas", loaded);
   const std::string first = bytesOf(dir.path() / "a.atlas"), second = bytesOf(dir.path() / "b.atlas");

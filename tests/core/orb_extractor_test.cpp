@@ -2,9 +2,9 @@
 
 #include <opencv2/imgproc.hpp>
 
+#include "common/look_alikes.hpp"
 #include "core/features/brief_pattern.hpp"
 #include "core/features/hamming.hpp"
-#include "core/features/look_alikes.hpp"
 #include "core/features/orb_extractor.hpp"
 #include "synth/renderer.hpp"
 #include "synth/sequence.hpp"
@@ -214,6 +214,27 @@ TEST(LookAlikes, ARepeatedPatternHasTwinsARandomOneDoesNot) {
   EXPECT_EQ(lookAlikeDistances(two, same), (std::vector<uint8_t>{255, 255}));  // 10 px apart
   two[1].pt.x = 130;
   EXPECT_EQ(lookAlikeDistances(two, same), (std::vector<uint8_t>{0, 0}));
+}
+
+// A corner found only at the lower threshold is flagged weak: on faint squares beside strong
+// ones, the weak corners are all on the faint half and the strong ones all on the other.
+TEST(OrbExtractor, FlagsTheCornersFoundOnlyAtTheLowerThreshold) {
+  cv::Mat img(480, 640, CV_8U);
+  for (int y = 0; y < img.rows; ++y)
+    for (int x = 0; x < img.cols; ++x) {
+      const bool square = x % 32 < 12 && y % 32 < 12;
+      img.at<uchar>(y, x) = x < 320 ? (square ? 200 : 40) : (square ? 134 : 120);  // contrast 160 | 14
+    }
+  cv::GaussianBlur(img, img, {0, 0}, 0.7);
+  const auto [kps, desc] = extractDefault(img);
+  int weak_left = 0, weak_right = 0, strong_right = 0;
+  for (const auto& k : kps) {
+    if (isWeakCorner(k)) (k.pt.x < 300 ? weak_left : weak_right)++;
+    else strong_right += k.pt.x > 340;
+  }
+  EXPECT_EQ(weak_left, 0);
+  EXPECT_GT(weak_right, 50);
+  EXPECT_EQ(strong_right, 0);
 }
 
 TEST(OrbExtractor, DeterministicAndCheapOnBlankImages) {

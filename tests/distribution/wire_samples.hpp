@@ -2,6 +2,7 @@
 // Valid wire records of every kind, for the wire tests and the fuzzer's seed corpus
 // (fuzz/wire_seeds.cpp): a full keyframe with its features, a point and a companion, a global
 // map batch with erasures, and re-measured observations.
+#include "core/features/orb_extractor.hpp"
 #include "distribution/wire/record_codec.hpp"
 
 namespace hiveslam::distribution {
@@ -25,6 +26,7 @@ inline KeyFrameMessage sampleKeyframe() {
     k.frame.points.emplace_back(10.0 * i, 20.0);
     for (int b = 0; b < 32; ++b) k.frame.descriptors.at<uint8_t>(i, b) = static_cast<uint8_t>(i * 32 + b);
   }
+  k.frame.keypoints[1].class_id = features::kWeakCorner;
   k.matches = {{0, 100}, {2, 101}};
   PointRecord p;
   p.id = 100;

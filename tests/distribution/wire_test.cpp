@@ -23,6 +23,8 @@ TEST(Wire, KeyframeRoundTrip) {
   EXPECT_EQ(back.keyframe.matches, m.keyframe.matches);
   ASSERT_EQ(back.keyframe.frame.size(), 3u);
   EXPECT_EQ(back.keyframe.frame.keypoints[2].octave, 2);
+  EXPECT_EQ(back.keyframe.frame.keypoints[1].octave, 1);  // the weak flag rides above the level
+  for (int i = 0; i < 3; ++i) EXPECT_EQ(features::isWeakCorner(back.keyframe.frame.keypoints[static_cast<size_t>(i)]), i == 1);
   EXPECT_EQ(cv::norm(back.keyframe.frame.descriptors, m.keyframe.frame.descriptors, cv::NORM_HAMMING), 0);
   ASSERT_EQ(back.points.size(), 1u);
   EXPECT_NEAR((back.points[0].position - m.points[0].position).norm(), 0, 1e-6);

@@ -5,7 +5,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "common/error.hpp"
-#include "common/look_alike_share.hpp"
+#include "common/look_alikes.hpp"
 #include "io/open_dataset.hpp"
 #include <opencv2/imgcodecs.hpp>
 #include "synth/renderer.hpp"

@@ -1,29 +1,11 @@
 #pragma once
-// Hamming distance of two 256-bit descriptors (32-byte rows), by popcount on 64-bit words.
-#include <cstdint>
-#include <cstring>
+// Descriptor distances for the matchers: the Hamming distance (common/hamming.hpp) and the ratio test.
+#include "common/hamming.hpp"
 
 namespace hiveslam::features {
 
-// Bit count of a 64-bit word by the parallel (SWAR) method, inline: baseline x86-64 has no
-// popcount instruction, and std::popcount there is a library call per word.
-inline int popcount64(uint64_t v) {
-  v = v - ((v >> 1) & 0x5555555555555555ULL);
-  v = (v & 0x3333333333333333ULL) + ((v >> 2) & 0x3333333333333333ULL);
-  v = (v + (v >> 4)) & 0x0f0f0f0f0f0f0f0fULL;
-  return static_cast<int>((v * 0x0101010101010101ULL) >> 56);
-}
-
-inline int hamming(const unsigned char* a, const unsigned char* b) {
-  int d = 0;
-  for (int i = 0; i < 4; ++i) {
-    uint64_t x, y;
-    std::memcpy(&x, a + 8 * i, 8);
-    std::memcpy(&y, b + 8 * i, 8);
-    d += popcount64(x ^ y);
-  }
-  return d;
-}
+using hiveslam::hamming;
+using hiveslam::popcount64;
 
 // The nearest and second-nearest descriptor distances offered so far, for the ratio test that
 // every matcher applies: a match counts only when it is clearly better than the runner-up.

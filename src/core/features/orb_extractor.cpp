@@ -298,6 +298,10 @@ void OrbExtractor::extract(const cv::Mat& gray, std::vector<cv::KeyPoint>& keypo
       ++per_cell[static_cast<size_t>(static_cast<int>(kp.pt.y) / cs * cols + static_cast<int>(kp.pt.x) / cs)];
       found.push_back(kp);
     };
+    auto weak = [](cv::KeyPoint kp) {
+      kp.class_id = kWeakCorner;
+      return kp;
+    };
     std::vector<cv::KeyPoint>& k = scratch.fast;
     // The whole level with a 3 px margin for the FAST circle, taken from the reflected border.
     const cv::Rect all(kBorder - 3, kBorder - 3, W + 6, H + 6);
@@ -312,7 +316,7 @@ void OrbExtractor::extract(const cv::Mat& gray, std::vector<cv::KeyPoint>& keypo
       for (const auto& kp : k) {
         const int x = static_cast<int>(kp.pt.x - 3), y = static_cast<int>(kp.pt.y - 3);
         if (x < 0 || y < 0 || x >= W || y >= H) continue;
-        if (scratch.first_pass[static_cast<size_t>(y / cs * cols + x / cs)] == 0) keep(kp, -3.0f, -3.0f);
+        if (scratch.first_pass[static_cast<size_t>(y / cs * cols + x / cs)] == 0) keep(weak(kp), -3.0f, -3.0f);
       }
     } else {
       for (int cy = 0; cy < rows; ++cy)
@@ -325,7 +329,7 @@ void OrbExtractor::extract(const cv::Mat& gray, std::vector<cv::KeyPoint>& keypo
             // Only corners inside this cell: its neighbours already have their own.
             if (kp.pt.x - 3 < 0 || kp.pt.y - 3 < 0 || kp.pt.x - 3 >= std::min(cs, W - x0) || kp.pt.y - 3 >= std::min(cs, H - y0))
               continue;
-            keep(kp, static_cast<float>(x0 - 3), static_cast<float>(y0 - 3));
+            keep(weak(kp), static_cast<float>(x0 - 3), static_cast<float>(y0 - 3));
           }
         }
     }

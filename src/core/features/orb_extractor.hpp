@@ -23,6 +23,12 @@ struct OrbOptions {
   bool subpixel = true;
 };
 
+// A corner found only at min_fast_threshold, in a cell where fast_threshold found none, carries
+// this class_id (the others -1). On plain walls these are the image noise's, and on the
+// realistic suite two of three wrong new points come from them (docs/BENCHMARKS.md).
+constexpr int kWeakCorner = 1;
+inline bool isWeakCorner(const cv::KeyPoint& k) { return k.class_id == kWeakCorner; }
+
 class OrbExtractor {
  public:
   explicit OrbExtractor(const OrbOptions& options = {});

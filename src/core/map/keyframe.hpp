@@ -43,8 +43,8 @@ class KeyFrame : public std::enable_shared_from_this<KeyFrame> {
   // Bag of words of the image, set before the keyframe is shared and never changed after.
   place::BowVector bow;
   place::FeatureVector bow_features;
-  // Per keypoint, the distance to its nearest look-alike in this image
-  // (core/features/look_alikes.hpp): filled by local mapping, under the map's lock, when it first
+  // Per weak corner, the distance to its nearest look-alike in this image (common/look_alikes.hpp;
+  // 255 for the others): filled by local mapping, under the map's lock, when it first
   // triangulates with this keyframe.
   std::vector<uint8_t> look_alikes;
   // Loop and merge links: kept by the essential graph, and never culled.

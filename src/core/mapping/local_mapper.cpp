@@ -6,8 +6,8 @@
 #include <optional>
 #include <set>
 
+#include "common/look_alikes.hpp"
 #include "core/features/hamming.hpp"
-#include "core/features/look_alikes.hpp"
 #include "core/features/rotation_histogram.hpp"
 #include "core/geometry/skew.hpp"
 #include "core/geometry/triangulation.hpp"
@@ -155,17 +155,21 @@ void LocalMapper::triangulateNewPoints(Map& map, KeyFrame& kf) {
     if ((nb->center() - C1).norm() / depths[depths.size() / 2] < 0.01) continue;
 
     const Eigen::Isometry3d T21 = nb->T_cw * T1w.inverse();  // kf frame -> neighbour frame
+    // Look-alikes of the corners found only at the detector's lower threshold: on handheld4 of
+    // the realistic suite 2995 of 3068 wrong new points from such corners had one at least as
+    // close as their partner, where strong corners' wrong pairs mostly did not (92 of 122).
     const double look_alike_ratio = settings_.triangulation_look_alike_ratio;
     if (look_alike_ratio > 0) {
       for (KeyFrame* k : {&kf, nb})
-        if (k->look_alikes.empty()) k->look_alikes = features::lookAlikeDistances(k->frame.keypoints, k->frame.descriptors);
+        if (k->look_alikes.empty()) k->look_alikes = lookAlikeDistances(k->frame.keypoints, k->frame.descriptors, features::isWeakCorner);
     }
     for (const auto& [ii, best_j] : epipolarPairs(kf, *nb, T21)) {
       const size_t i = static_cast<size_t>(ii);
       const size_t j = static_cast<size_t>(best_j);
       if (look_alike_ratio > 0) {
+        const int twin = std::min(kf.look_alikes[i], nb->look_alikes[j]);
         const int d = features::hamming(kf.frame.descriptors.ptr<uchar>(ii), nb->frame.descriptors.ptr<uchar>(best_j));
-        if (d >= look_alike_ratio * std::min(kf.look_alikes[i], nb->look_alikes[j])) continue;
+        if (twin < 255 && d >= look_alike_ratio * twin) continue;
       }
       const double s1 = scales_[static_cast<size_t>(kf.frame.keypoints[i].octave)];
       const double s2 = scales_[static_cast<size_t>(nb->frame.keypoints[j].octave)];

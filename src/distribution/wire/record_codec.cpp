@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "core/features/orb_extractor.hpp"
 #include "distribution/wire/byte_codec.hpp"
 
 namespace hiveslam::distribution {
@@ -97,13 +98,14 @@ void putKeyframe(ByteWriter& w, const KeyFrameRecord& k) {
   putPose(w, k.T_made_from);
   w.put(static_cast<uint32_t>(f.keypoints.size()));
   // Per keypoint what the core uses after extraction: image position, angle and pyramid level
-  // (matching and scale prediction), the undistorted position (geometry) and the descriptor.
+  // (matching and scale prediction) with the weak-corner flag in its top bit (triangulation's
+  // look-alike check), the undistorted position (geometry) and the descriptor.
   for (size_t i = 0; i < f.keypoints.size(); ++i) {
     const cv::KeyPoint& kp = f.keypoints[i];
     w.put(kp.pt.x);
     w.put(kp.pt.y);
     w.put(kp.angle);
-    w.put(static_cast<uint8_t>(kp.octave));
+    w.put(static_cast<uint8_t>(kp.octave | (features::isWeakCorner(kp) ? 0x80 : 0)));
     w.put(static_cast<float>(f.points[i].x()));
     w.put(static_cast<float>(f.points[i].y()));
     w.bytes(f.descriptors.ptr<uint8_t>(static_cast<int>(i)), 32);
@@ -155,7 +157,9 @@ KeyFrameRecord getKeyframe(ByteReader& r) {
     kp.pt.x = r.get<float>();
     kp.pt.y = r.get<float>();
     kp.angle = r.get<float>();
-    kp.octave = r.get<uint8_t>();
+    const auto level = r.get<uint8_t>();
+    kp.octave = level & 0x7f;
+    kp.class_id = (level & 0x80) ? features::kWeakCorner : -1;
     if (kp.octave > 31) throw WireError("bad keypoint level");
     const float x = r.get<float>(), y = r.get<float>();
     // Not a number, a point would be put in a grid cell by an undefined cast (found by
