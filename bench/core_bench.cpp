@@ -1,7 +1,7 @@
 // Speed of the SLAM core: the per-frame work at 752x480 with 1000 features (ORB extraction with
 // and without sub-pixel corners, the whole frame construction, pose-only optimization, called
 // twice per tracked frame), and the mapping and loop closing solvers (bag-of-words transform,
-// Sim3 RANSAC, essential graph, bundle adjustment). End-to-end tracking time is
+// Sim3 RANSAC, two-view initialization, essential graph, bundle adjustment). End-to-end tracking time is
 // `hiveslam run --realtime`'s tracking_ms (docs/BENCHMARKS.md).
 #include <benchmark/benchmark.h>
 
@@ -13,6 +13,7 @@
 
 #include "core/frame/frame.hpp"
 #include "core/geometry/pnp_ransac.hpp"
+#include "core/geometry/two_view.hpp"
 #include "core/geometry/sim3_solver.hpp"
 #include "core/optim/bundle_adjustment.hpp"
 #include "core/optim/pose_graph.hpp"
@@ -157,6 +158,30 @@ void PnpRansacClassic(benchmark::State& state) {
   }
 }
 BENCHMARK(PnpRansacClassic)->Arg(15)->Arg(35)->Arg(70)->Unit(benchmark::kMicrosecond);
+
+// A two-view initialization attempt on 110 matches of which state.range(0) percent are right
+// (a lost tracker near the 100-match minimum holds 20-40%, one that makes a map most), with
+// RANSAC's iterations at state.range(1): 1 the defaults (150 essential, 300 homography), 0
+// the earlier 1000 and 2000.
+void TwoViewAttempt(benchmark::State& state) {
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> u(-1, 1);
+  const hiveslam::core::Intrinsics K{500, 500, 320, 240};
+  const Eigen::Isometry3d T_21 = Eigen::Translation3d(0.1, 0, 0) * Eigen::AngleAxisd(0.05, Eigen::Vector3d::UnitY());
+  std::vector<Eigen::Vector2d> p1, p2;
+  for (int i = 0; i < 110; ++i) {
+    const Eigen::Vector3d p(u(rng), u(rng), 3 + u(rng));
+    p1.push_back(K.project(p));
+    p2.push_back(i * 100 < state.range(0) * 110 ? K.project(T_21 * p) : Eigen::Vector2d(320 + 300 * u(rng), 240 + 200 * u(rng)));
+  }
+  hiveslam::core::TwoViewOptions o;
+  if (state.range(1) == 0) {
+    o.essential_iterations = 1000;
+    o.homography_iterations = 2000;
+  }
+  for (auto _ : state) benchmark::DoNotOptimize(hiveslam::core::initializeTwoView(p1, p2, K, o));
+}
+BENCHMARK(TwoViewAttempt)->ArgsProduct({{30, 80}, {0, 1}})->Unit(benchmark::kMillisecond);
 
 // Essential graph of N keyframes around a circle: a chain plus covisibility edges to the next
 // three, one loop edge, drift to spread.

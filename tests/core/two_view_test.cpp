@@ -203,5 +203,22 @@ TEST(TwoView, RecoversTheRoadOnABaselineItCanResolve) {
   }
 }
 
+TEST(TwoView, MakesAMapWhereAMajorityOfTheMatchesAgree) {
+  // RANSAC's iterations are capped (TwoViewOptions) so that a lost tracker's hopeless attempts
+  // stay short; a pair where 65% of the matches are right must still give the motion.
+  for (uint64_t seed = 1; seed <= 10; ++seed) {
+    RoadMatches m = roadScene(3.0, seed);
+    std::mt19937 rng(static_cast<unsigned>(seed));
+    std::uniform_real_distribution<double> x(0, 1226), y(0, 370);
+    for (size_t i = 0; i < m.p2.size(); ++i)
+      if (i % 20 < 7) m.p2[i] = {x(rng), y(rng)};
+    TwoViewOptions o;
+    o.seed = seed;
+    const TwoViewResult r = initializeTwoView(m.p1, m.p2, m.K, o);
+    ASSERT_TRUE(r.ok) << "seed " << seed << ": " << r.reason;
+    EXPECT_LT(rotationErrorDeg(r, m.T_21), 0.5) << "seed " << seed;
+  }
+}
+
 }  // namespace
 }  // namespace hiveslam::core

@@ -116,9 +116,11 @@ TwoViewResult initializeTwoView(const std::vector<Eigen::Vector2d>& p1, const st
   const cv::Matx33d Kcv(K.fx, 0, K.cx, 0, K.fy, K.cy, 0, 0, 1);
   // OpenCV's RANSAC draws from the calling thread's RNG: seed it for repeatable maps.
   cv::setRNGSeed(static_cast<int>(o.seed & 0x7fffffff));
-  const cv::Mat Hcv = cv::findHomography(a, b, cv::RANSAC, 2.0 * o.sigma_px * std::sqrt(kChi2_2dof), cv::noArray(), 2000, 0.999);
+  const cv::Mat Hcv = cv::findHomography(a, b, cv::RANSAC, 2.0 * o.sigma_px * std::sqrt(kChi2_2dof), cv::noArray(),
+                                         o.homography_iterations, 0.999);
   cv::setRNGSeed(static_cast<int>((o.seed + 1) & 0x7fffffff));
-  const cv::Mat Ecv = cv::findEssentialMat(a, b, Kcv, cv::RANSAC, 0.999, o.sigma_px * std::sqrt(kChi2_1dof));
+  const cv::Mat Ecv = cv::findEssentialMat(a, b, Kcv, cv::RANSAC, 0.999, o.sigma_px * std::sqrt(kChi2_1dof),
+                                           o.essential_iterations);
   if (Ecv.rows != 3 || Ecv.cols != 3) {
     r.reason = "no essential matrix";
     return r;
