@@ -107,7 +107,7 @@ void addEvalCommand(CLI::App& app) {
   ate_cmd->add_option("--plot-axes", plots->second, "Write a PNG of the error along x, y and z over time");
   auto stretches = std::make_shared<int>(0);
   ate_cmd->add_option("--stretches", *stretches,
-                      "Also cut the run into N equal stretches of time: each one's mean error and own Sim3 scale")
+                      "Also cut the run into N equal stretches of time: each one's mean error, own Sim3 scale and turn")
       ->check(CLI::Range(1, 1000));
   ate_cmd->callback([ate, stretches, plots]() {
     const Loaded l = load(*ate);
@@ -125,7 +125,8 @@ void addEvalCommand(CLI::App& app) {
         j["stretches"] = nlohmann::json::array();
         for (const auto& s : eval::stretchErrors(r, *stretches))
           j["stretches"].push_back({{"from", s.from}, {"to", s.to}, {"poses", s.poses}, {"mean_error", s.mean_error},
-                                    {"scale", s.scale}});
+                                    {"scale", s.scale}, {"turn_deg", s.turn}, {"turn_estimate_deg", s.turn_estimate},
+                                    {"turn_error_deg", s.turn_error}});
       }
       fmt::print("{}\n", j.dump(2));
       return;
@@ -134,9 +135,11 @@ void addEvalCommand(CLI::App& app) {
                            r.pair.alignment.scale),
                r.stats, "m");
     if (*stretches > 0) {
-      fmt::print("{:>16}  {:>6}  {:>12}  {:>12}\n", "stretch (s)", "poses", "mean error", "own scale");
+      fmt::print("{:>16}  {:>6}  {:>12}  {:>12}  {:>22}\n", "stretch (s)", "poses", "mean error", "own scale",
+                 "turn, deg: true / est / err");
       for (const auto& s : eval::stretchErrors(r, *stretches))
-        fmt::print("{:>7.1f} - {:>6.1f}  {:>6}  {:>10.4f} m  {:>12.4f}\n", s.from, s.to, s.poses, s.mean_error, s.scale);
+        fmt::print("{:>7.1f} - {:>6.1f}  {:>6}  {:>10.4f} m  {:>12.4f}  {:>8.2f} {:>6.2f} {:>6.2f}\n", s.from, s.to,
+                   s.poses, s.mean_error, s.scale, s.turn, s.turn_estimate, s.turn_error);
     }
   });
 
