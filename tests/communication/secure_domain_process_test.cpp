@@ -10,6 +10,7 @@
 #include <string>
 
 #include "synth/sequence.hpp"
+#include "rendered_sequence.hpp"
 #include "temp_dir.hpp"
 
 namespace hiveslam {
@@ -41,7 +42,7 @@ TEST(SecureDomain, AClusterWithKeysMapsAndStrangersHearNothing) {
   seq.trajectory = "loop";
   seq.frames = 240;
   seq.seed = 5;
-  synth::writeSequence(seq, dir / "loop", nullptr);
+  const fs::path loop = testing::renderedSequence(seq, "loop240_seed5");
   ASSERT_EQ(run(kBinary + " keys --out " + (dir / "keys").string() + " > /dev/null"), 0);
   ASSERT_EQ(run(kBinary + " keys --out " + (dir / "other").string() + " --nodes lm > /dev/null"), 0);
   const std::string domain = "231";
@@ -53,7 +54,7 @@ TEST(SecureDomain, AClusterWithKeysMapsAndStrangersHearNothing) {
       domain + " --secure " + (dir / "other").string() + " --out " + (dir / "otherca").string() + " > " +
       (dir / "otherca.log").string() + " 2>&1 & b=$!; sleep 1; ";
   const std::string cluster = kBinary + " cluster --nodes 3 --domain " + domain + " --secure " + (dir / "keys").string() + " " +
-                              (dir / "loop").string() + " --out " + (dir / "out").string() + " > " +
+                              loop.string() + " --out " + (dir / "out").string() + " > " +
                               (dir / "cluster.log").string() + " 2>&1; s=$?; kill $a $b; wait $a $b; exit $s";
   ASSERT_EQ(run("bash -c '" + strangers + cluster + "'"), 0) << logOf(dir / "cluster.log");
   const auto tr = report(dir / "out" / "tr" / "report.json"), lm = report(dir / "out" / "lm" / "report.json"),

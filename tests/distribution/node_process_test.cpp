@@ -12,12 +12,14 @@
 #include <cstdlib>
 #include <fstream>
 #include <iostream>
+#include <map>
 #include <nlohmann/json.hpp>
 #include <sstream>
 #include <vector>
 
 #include "io/atlas_file.hpp"
 #include "synth/sequence.hpp"
+#include "rendered_sequence.hpp"
 #include "temp_dir.hpp"
 
 extern char** environ;
@@ -35,18 +37,17 @@ constexpr bool kSanitized = HIVESLAM_SANITIZED;
 const std::string kRealtime = kSanitized ? "" : " --realtime";
 const std::string kPlayRate = kSanitized ? " --rate 0.1" : "";
 
-// A short rendered loop, made once for the tests of this file.
-const fs::path& sequence() {
-  static testing::TempDir dir;
-  static const fs::path seq = [] {
+// The rendered loop of these tests (see rendered_sequence.hpp): 240 frames, or 900.
+const fs::path& sequence(int frames = 240) {
+  static std::map<int, fs::path> made;
+  if (!made.count(frames)) {
     synth::SequenceOptions o;
     o.trajectory = "loop";
-    o.frames = 240;
+    o.frames = frames;
     o.seed = 5;
-    synth::writeSequence(o, dir / "loop", nullptr);
-    return dir / "loop";
-  }();
-  return seq;
+    made[frames] = testing::renderedSequence(o, "loop" + std::to_string(frames) + "_seed5");
+  }
+  return made[frames];
 }
 
 nlohmann::json report(const fs::path& file) {
@@ -651,17 +652,12 @@ void expectHealsAfterCut(int domain, int at, int lasting, const std::vector<int>
   const Namespaces ns;
   if (!ns.skipReason().empty()) GTEST_SKIP() << ns.skipReason();
   testing::TempDir out;
-  synth::SequenceOptions o;
-  o.trajectory = "loop";
-  o.frames = 900;
-  o.seed = 5;
-  synth::writeSequence(o, out / "loop900", nullptr);
   // At the heal TR hands its map over while it tracks; the heal is judged here, not the policy
   // that releases peers over a slow link (tests of its own): under load the first answers of the
   // new gateway took over a second and TR released its peers, so TR keeps offloading.
   std::ofstream(out / "offload.yaml") << "distribution:\n  release_slow_gateway_ms: 0\n";
   const int status = runInNamespaces(ns, out.path(), domain, kRealtime + " --config " + (out / "offload.yaml").string(),
-                                     ns.partition(at, lasting, peers, stagger), out / "loop900", true);
+                                     ns.partition(at, lasting, peers, stagger), sequence(900), true);
   ASSERT_EQ(status, 0) << nodeEvents(out.path());
   expectHealed(out.path());
   if (::testing::Test::HasFailure()) std::cout << nodeEvents(out.path());

@@ -20,6 +20,7 @@
 #include "nav_msgs/msg/PathPubSubTypes.h"
 #include "sensor_msgs/msg/PointCloud2PubSubTypes.h"
 #include "synth/sequence.hpp"
+#include "rendered_sequence.hpp"
 #include "temp_dir.hpp"
 #include "tf2_msgs/msg/TFMessagePubSubTypes.h"
 #include "visualization_msgs/msg/MarkerArrayPubSubTypes.h"
@@ -35,16 +36,15 @@ namespace dds = eprosima::fastdds::dds;
 constexpr bool kSanitized = HIVESLAM_SANITIZED;
 const std::string kRealtime = kSanitized ? "" : " --realtime";
 
+// The rendered loop of these tests (see rendered_sequence.hpp).
 const fs::path& sequence(int frames) {
-  static testing::TempDir dir;
   static std::map<int, fs::path> made;
   if (!made.count(frames)) {
     synth::SequenceOptions o;
     o.trajectory = "loop";
     o.frames = frames;
     o.seed = 5;
-    synth::writeSequence(o, dir / ("loop" + std::to_string(frames)), nullptr);
-    made[frames] = dir / ("loop" + std::to_string(frames));
+    made[frames] = testing::renderedSequence(o, "loop" + std::to_string(frames) + "_seed5");
   }
   return made[frames];
 }
