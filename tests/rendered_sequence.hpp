@@ -12,6 +12,7 @@
 #include <unistd.h>
 
 #include <filesystem>
+#include <map>
 #include <stdexcept>
 #include <string>
 
@@ -40,6 +41,19 @@ inline std::filesystem::path renderedSequence(const synth::SequenceOptions& opti
   }
   ::close(lock);  // releases the lock
   return dir;
+}
+
+// The process tests' loop (seed 5) of this many frames, rendered as above.
+inline const std::filesystem::path& renderedLoop(int frames) {
+  static std::map<int, std::filesystem::path> made;
+  if (!made.count(frames)) {
+    synth::SequenceOptions o;
+    o.trajectory = "loop";
+    o.frames = frames;
+    o.seed = 5;
+    made[frames] = renderedSequence(o, "loop" + std::to_string(frames) + "_seed5");
+  }
+  return made[frames];
 }
 
 }  // namespace hiveslam::testing

@@ -1,17 +1,8 @@
 #include "eval/stretch_errors.hpp"
 
-#include <Eigen/Geometry>
-#include <cmath>
-
 #include "common/error.hpp"
 
 namespace hiveslam::eval {
-
-namespace {
-
-double degrees(const Eigen::Matrix3d& R) { return Eigen::AngleAxisd(R).angle() * 180.0 / M_PI; }
-
-}  // namespace
 
 std::vector<Stretch> stretchErrors(const AteResult& ate, int stretches) {
   if (stretches < 1) throw InputError("the run must be cut into at least 1 stretch");
@@ -47,9 +38,9 @@ std::vector<Stretch> stretchErrors(const AteResult& ate, int stretches) {
     const Eigen::Matrix3d ref_turn = ref.poses[m.front()].linear().transpose() * ref.poses[m.back()].linear();
     const Eigen::Matrix3d est_turn =
         ate.pair.est.poses[m.front()].linear().transpose() * ate.pair.est.poses[m.back()].linear();
-    out[k].turn = degrees(ref_turn);
-    out[k].turn_estimate = degrees(est_turn);
-    out[k].turn_error = degrees(ref_turn.transpose() * est_turn);
+    out[k].turn = rotationDegrees(ref_turn);
+    out[k].turn_estimate = rotationDegrees(est_turn);
+    out[k].turn_error = rotationDegrees(ref_turn.transpose() * est_turn);
   }
   return out;
 }

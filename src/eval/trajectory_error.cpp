@@ -16,6 +16,8 @@ std::string toString(Alignment a) {
   return "?";
 }
 
+double rotationDegrees(const Eigen::Matrix3d& R) { return Eigen::AngleAxisd(R).angle() * 180.0 / M_PI; }
+
 AlignedPair matchAndAlign(const io::Trajectory& ref, const io::Trajectory& est,
                           const MatchOptions& options) {
   const Association a =
@@ -106,7 +108,7 @@ RpeResult computeRpe(const io::Trajectory& ref, const io::Trajectory& est, const
     if (o.relation == RpeRelation::Translation) {
       r.errors.push_back(E.translation().norm());
     } else {
-      r.errors.push_back(Eigen::AngleAxisd(E.linear()).angle() * 180.0 / M_PI);
+      r.errors.push_back(rotationDegrees(E.linear()));
     }
   }
   if (r.errors.empty()) throw InputError("no RPE pairs for this delta: the trajectory is too short");

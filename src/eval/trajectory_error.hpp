@@ -20,6 +20,9 @@ struct MatchOptions {
   Alignment alignment = Alignment::Sim3;
 };
 
+// The angle of a rotation, in degrees (RPE's rotation part, a stretch's turn).
+double rotationDegrees(const Eigen::Matrix3d& R);
+
 // The matched, aligned pair both metrics start from.
 struct AlignedPair {
   io::Trajectory ref;  // matched reference poses

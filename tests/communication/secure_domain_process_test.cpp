@@ -9,7 +9,6 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
-#include "synth/sequence.hpp"
 #include "rendered_sequence.hpp"
 #include "temp_dir.hpp"
 
@@ -38,11 +37,7 @@ int run(const std::string& cmd) {
 
 TEST(SecureDomain, AClusterWithKeysMapsAndStrangersHearNothing) {
   testing::TempDir dir;
-  synth::SequenceOptions seq;
-  seq.trajectory = "loop";
-  seq.frames = 240;
-  seq.seed = 5;
-  const fs::path loop = testing::renderedSequence(seq, "loop240_seed5");
+  const fs::path& loop = testing::renderedLoop(240);
   ASSERT_EQ(run(kBinary + " keys --out " + (dir / "keys").string() + " > /dev/null"), 0);
   ASSERT_EQ(run(kBinary + " keys --out " + (dir / "other").string() + " --nodes lm > /dev/null"), 0);
   const std::string domain = "231";

@@ -12,13 +12,11 @@
 #include <cstdlib>
 #include <fstream>
 #include <iostream>
-#include <map>
 #include <nlohmann/json.hpp>
 #include <sstream>
 #include <vector>
 
 #include "io/atlas_file.hpp"
-#include "synth/sequence.hpp"
 #include "rendered_sequence.hpp"
 #include "temp_dir.hpp"
 
@@ -37,18 +35,8 @@ constexpr bool kSanitized = HIVESLAM_SANITIZED;
 const std::string kRealtime = kSanitized ? "" : " --realtime";
 const std::string kPlayRate = kSanitized ? " --rate 0.1" : "";
 
-// The rendered loop of these tests (see rendered_sequence.hpp): 240 frames, or 900.
-const fs::path& sequence(int frames = 240) {
-  static std::map<int, fs::path> made;
-  if (!made.count(frames)) {
-    synth::SequenceOptions o;
-    o.trajectory = "loop";
-    o.frames = frames;
-    o.seed = 5;
-    made[frames] = testing::renderedSequence(o, "loop" + std::to_string(frames) + "_seed5");
-  }
-  return made[frames];
-}
+// The rendered loop of these tests: 240 frames, or 900.
+const fs::path& sequence(int frames = 240) { return testing::renderedLoop(frames); }
 
 nlohmann::json report(const fs::path& file) {
   std::ifstream in(file);

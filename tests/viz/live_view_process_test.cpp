@@ -19,7 +19,6 @@
 #include "geometry_msgs/msg/PoseStampedPubSubTypes.h"
 #include "nav_msgs/msg/PathPubSubTypes.h"
 #include "sensor_msgs/msg/PointCloud2PubSubTypes.h"
-#include "synth/sequence.hpp"
 #include "rendered_sequence.hpp"
 #include "temp_dir.hpp"
 #include "tf2_msgs/msg/TFMessagePubSubTypes.h"
@@ -36,18 +35,8 @@ namespace dds = eprosima::fastdds::dds;
 constexpr bool kSanitized = HIVESLAM_SANITIZED;
 const std::string kRealtime = kSanitized ? "" : " --realtime";
 
-// The rendered loop of these tests (see rendered_sequence.hpp).
-const fs::path& sequence(int frames) {
-  static std::map<int, fs::path> made;
-  if (!made.count(frames)) {
-    synth::SequenceOptions o;
-    o.trajectory = "loop";
-    o.frames = frames;
-    o.seed = 5;
-    made[frames] = testing::renderedSequence(o, "loop" + std::to_string(frames) + "_seed5");
-  }
-  return made[frames];
-}
+// The rendered loop of these tests.
+const fs::path& sequence(int frames) { return testing::renderedLoop(frames); }
 
 std::string slurp(const fs::path& file) {
   std::ifstream in(file);
