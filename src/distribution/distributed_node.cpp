@@ -49,11 +49,14 @@ DistributedNode::DistributedNode(core::SlamSystem& slam, communication::Transpor
       integrator_,
       [this](const StateIntegrator::Added& a, uint8_t target) {
         if (target == kTargetLc) {
+          std::shared_ptr<core::KeyFrame> kf = a.keyframe;
           {
             std::lock_guard lock(a.map->mutex);
-            core::insertKeyframe(*a.map, *a.keyframe, slam_.scales(), &slam_.database());
+            core::insertKeyframe(*a.map, *kf, slam_.scales(), &slam_.database());
+            // A snapshot brought the keyframe first: loop detection takes the map's copy.
+            if (auto it = a.map->keyframes.find(kf->id); kf->bad && it != a.map->keyframes.end()) kf = it->second;
           }
-          slam_.submit(a.map, a.keyframe, core::SlamSystem::Module::LoopClosing);
+          slam_.submit(a.map, kf, core::SlamSystem::Module::LoopClosing);
         } else {
           slam_.submit(a.map, a.keyframe, core::SlamSystem::Module::Mapping);
         }

@@ -63,5 +63,57 @@ TEST(LocalMapper, AKeyframeCulledBeforeItsTurnStaysOutOfTheMap) {
   for (const auto& [id, p] : row.map->points) EXPECT_FALSE(p->observations.count(waiting.get())) << "point " << id;
 }
 
+// Two copies of one keyframe can be made at a loop-closing node: one from its keyframe message
+// (the keyframe subscriber's thread), one from a hand-over snapshot that brings keyframes the
+// node lacks (the map handler's), each made while the other was not in the map yet. The second
+// to be inserted once linked to itself the points the first did not see (observations are keyed
+// by id, so the others kept the first), and the first's neighbours; freed with its message, it
+// left them pointing at freed memory (a CI run's LC crashed in MapPoint::update two seconds
+// after such a snapshot).
+TEST(LocalMapper, ASecondCopyOfAMappedKeyframeLinksNothing) {
+  Row row;
+  KeyFrame& mapped = *row.kfs[3];
+  // The map's copy has lost some of its points since (fused or culled); the message's has them.
+  const auto links = mapped.points;
+  for (size_t i = 0; i < 10; ++i) {
+    mapped.points[i]->observations.erase(&mapped);
+    mapped.points[i].reset();
+  }
+  const auto copyOf = [&] {
+    auto copy = std::make_shared<KeyFrame>(mapped.id, mapped.frame, mapped.T_cw);
+    copy->points = links;
+    return copy;
+  };
+  const auto linked = [&](const KeyFrame* copy) {
+    int n = 0;
+    for (const auto& [id, p] : row.map->points)
+      for (const auto& [kf, i] : p->observations) n += kf == copy;
+    for (const auto& kf : row.kfs)
+      for (const auto& [other, w] : kf->covisibility) n += other == copy;
+    return n;
+  };
+  const std::vector<double> scales(8, 1.0);
+  auto copy = copyOf();
+  {
+    std::lock_guard lock(row.map->mutex);
+    insertKeyframe(*row.map, *copy, scales, nullptr);
+  }
+  EXPECT_EQ(row.map->keyframes.at(mapped.id).get(), &mapped);
+  EXPECT_TRUE(copy->bad) << "whoever holds the copy would go on mapping with it";
+  EXPECT_EQ(linked(copy.get()), 0) << "points or keyframes of the map link to the copy";
+
+  // Local mapping, given a copy, maps nothing with it and acknowledges it.
+  IdGenerator ids(1);
+  LocalMapper mapper(SlamSettings{}, ids, scales);
+  auto second = copyOf();
+  const size_t points = row.map->points.size();
+  bool acknowledged = false;
+  mapper.process(row.map, second, nullptr, [&] { acknowledged = true; });
+  EXPECT_TRUE(acknowledged);
+  EXPECT_EQ(mapper.stats().keyframes_processed, 0);
+  EXPECT_EQ(row.map->points.size(), points);
+  EXPECT_EQ(linked(second.get()), 0);
+}
+
 }  // namespace
 }  // namespace hiveslam::core

@@ -4,6 +4,10 @@ namespace hiveslam::core {
 
 void insertKeyframe(Map& map, KeyFrame& kf, const std::vector<double>& scales, KeyframeDatabase* database) {
   if (kf.bad) return;  // culled while it waited (see the header)
+  if (auto it = map.keyframes.find(kf.id); it != map.keyframes.end() && it->second.get() != &kf) {
+    kf.bad = true;  // another copy of it is mapped (see the header)
+    return;
+  }
   // The map moved (loop correction, global BA) while this keyframe waited in a queue: it moves
   // with the keyframe tracking posed it against.
   if (kf.made_in_epoch != map.epoch && kf.made_from) kf.T_cw = kf.made_from->poseOf(kf.made_pose);

@@ -77,13 +77,13 @@ void LocalMapper::process(const std::shared_ptr<Map>& map, const std::shared_ptr
   // Merged into another map since the job was queued: the keyframe is in the old frame and
   // the map is empty (SlamSystem drops such jobs; this closes the gap until the lock).
   if (map->merged_into.load()) return;
-  if (kf->bad) {
+  map->collectGarbage();
+  insert(*map, *kf);
+  if (kf->bad) {  // culled while it waited, or a copy of a keyframe in the map
     lock.unlock();
     if (before_ba) before_ba();
     return;
   }
-  map->collectGarbage();
-  insert(*map, *kf);
   clock.lap(&MappingStageMs::insert);
   cullRecentPoints(*map, *kf);
   clock.lap(&MappingStageMs::cull_points);
