@@ -54,7 +54,8 @@ DistributedNode::DistributedNode(core::SlamSystem& slam, communication::Transpor
             std::lock_guard lock(a.map->mutex);
             core::insertKeyframe(*a.map, *kf, slam_.scales(), &slam_.database());
             // A snapshot brought the keyframe first: loop detection takes the map's copy.
-            if (auto it = a.map->keyframes.find(kf->id); kf->bad && it != a.map->keyframes.end()) kf = it->second;
+            if (kf->bad)
+              if (auto it = a.map->keyframes.find(kf->id); it != a.map->keyframes.end()) kf = it->second;
           }
           slam_.submit(a.map, kf, core::SlamSystem::Module::LoopClosing);
         } else {
