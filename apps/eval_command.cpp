@@ -3,6 +3,7 @@
 // between two stretches, and how precisely the map's own measurements could fix it.
 // hiveslam eval bench DIR/bench.json: a saved bench's table and acceptance rules, again.
 // hiveslam eval remeasure ATLAS DATASET: a saved map on patch-aligned observations (eval_remeasure).
+// hiveslam eval lens ATLAS CAMERA: the lens a saved map was seen with (eval_lens).
 // hiveslam eval matches DATASET: data association against a render's scene (eval_matches).
 #include <fmt/format.h>
 
@@ -14,6 +15,7 @@
 #include "apps/bench.hpp"
 #include "apps/commands.hpp"
 #include "apps/eval_matches.hpp"
+#include "apps/eval_lens.hpp"
 #include "apps/eval_remeasure.hpp"
 #include "common/error.hpp"
 #include "eval/scale_precision.hpp"
@@ -247,6 +249,22 @@ void addEvalCommand(CLI::App& app) {
       windows.emplace_back(from, to);
     }
     evalRemeasure(pickMap(io::loadAtlas(*remeasure_atlas), *remeasure_map), *remeasure_dataset, *remeasure_split, windows);
+  });
+
+  auto lens_atlas = std::make_shared<std::string>(), lens_camera = std::make_shared<std::string>(),
+       lens_dataset = std::make_shared<std::string>(), lens_write = std::make_shared<std::string>();
+  auto lens_map = std::make_shared<long>(-1);
+  auto* lens_cmd = eval->add_subcommand(
+      "lens", "The lens a saved map was seen with: the given calibration refined against the map's own keypoints");
+  lens_cmd->footer("Example:\n  hiveslam eval lens out/handheld4/atlas.bin seq/handheld4/mav0/cam0/sensor.yaml --rendered seq/handheld4");
+  lens_cmd->add_option("ATLAS", *lens_atlas, "Atlas file (hiveslam run --atlas-out)")->required();
+  lens_cmd->add_option("CAMERA", *lens_camera, "The calibration the run was given (settings YAML, sensor.yaml or calib.txt)")
+      ->required();
+  lens_cmd->add_option("--rendered", *lens_dataset, "A sequence hiveslam synth wrote: print the lens its images were made with");
+  lens_cmd->add_option("--map", *lens_map, "Map id (default: the one with the most keyframes)");
+  lens_cmd->add_option("--write", *lens_write, "Write the refined lens as a settings file's camera section (for run --config)");
+  lens_cmd->callback([=]() {
+    evalLens(pickMap(io::loadAtlas(*lens_atlas), *lens_map), *lens_camera, *lens_dataset, *lens_write);
   });
 
   auto matches_dataset = std::make_shared<std::string>(), matches_config = std::make_shared<std::string>();

@@ -223,6 +223,14 @@ TEST(BadInput, ASavedBenchIsCheckedBeforeItIsRead) {
   expectOneLineFailure("eval bench " + (dir / "short_row.json").string(), "a row lacks what hiveslam bench writes");
 }
 
+TEST(BadInput, EvalLensNamesAMissingAtlasOrCamera) {
+  testing::TempDir dir;
+  expectOneLineFailure("eval lens " + (dir / "missing.bin").string() + " " + (dir / "missing.yaml").string(),
+                       "cannot open atlas");
+  std::ofstream(dir / "short.bin") << "hiveslam";
+  expectOneLineFailure("eval lens " + (dir / "short.bin").string() + " " + (dir / "missing.yaml").string(), "atlas");
+}
+
 TEST(BadInput, DistributionSettingsAreReadAndChecked) {
   testing::TempDir dir;
   const fs::path file = dir / "settings.yaml";
