@@ -87,15 +87,17 @@ LensRefinement refineLens(const BaProblem& problem, const LensParameters& start,
       ceres_problem.AddResidualBlock(cost, new ceres::HuberLoss(std::sqrt(kChi2)), pose.q_cw.coeffs().data(), pose.t_cw.data(),
                                      points[static_cast<size_t>(o.point)].p_w.data(), lens);
     }
-    for (size_t k = 0; k < poses.size(); ++k) {
-      double* q = poses[k].q_cw.coeffs().data();
+    int held = 0;
+    for (BaPose& pose : poses) {
+      double* q = pose.q_cw.coeffs().data();
       if (!ceres_problem.HasParameterBlock(q)) continue;
       ceres_problem.SetManifold(q, quaternion);
       quaternion_owned = false;
-      // The gauge: the two lowest poses hold the map's position, rotation and scale.
-      if (k < 2) {
+      // The gauge: the two lowest poses with observations hold the map's position, rotation and scale.
+      if (held < 2) {
         ceres_problem.SetParameterBlockConstant(q);
-        ceres_problem.SetParameterBlockConstant(poses[k].t_cw.data());
+        ceres_problem.SetParameterBlockConstant(pose.t_cw.data());
+        ++held;
       }
     }
     if (quaternion_owned) delete quaternion;

@@ -29,8 +29,8 @@ struct LensRefinementOptions {
 };
 
 // `problem`'s observations must be the keypoints as detected (rawObservations), its poses and
-// points a map made with `start`. The two lowest poses are held (the gauge: position, rotation and
-// scale); the problem is not changed.
+// points a map made with `start`. The two lowest poses with observations are held (the gauge:
+// position, rotation and scale); the problem is not changed.
 LensRefinement refineLens(const BaProblem& problem, const LensParameters& start, const LensRefinementOptions& options = {});
 
 // A map's problem with each observation where the detector found the keypoint, not where the
