@@ -276,6 +276,8 @@ void addEvalCommand(CLI::App& app) {
   matches_cmd->add_option("--frames", matches_options->frames, "Only the first N frames")->check(CLI::Range(1, 1000000));
   matches_cmd->add_flag("--true-lens", matches_options->true_lens,
                          "Give the SLAM the calibration the images were rendered with (a realistic render's nominal one is off)");
+  matches_cmd->add_flag("--oracle", matches_options->oracle,
+                        "Erase each new point that joins two scene points before its local BA (triangulation's pairs all right)");
   matches_cmd->add_flag("--sharp", matches_options->sharp,
                         "Render without motion blur, rolling shutter, hand tremor and lens error");
   matches_cmd->add_option("--config", *matches_config, "Settings YAML (its slam section)");

@@ -18,6 +18,7 @@
 #include "core/map/map.hpp"
 #include "core/map/map_point.hpp"
 #include "core/system/slam_system.hpp"
+#include "eval/trajectory_error.hpp"
 #include "synth/sequence.hpp"
 
 namespace hiveslam::apps {
@@ -84,7 +85,7 @@ double scaleOf(int octave) { return std::pow(1.2, octave); }
 
 class MatchProbe : public core::SystemEvents {
  public:
-  explicit MatchProbe(const SceneOracle& oracle) : oracle_(oracle) {}
+  MatchProbe(const SceneOracle& oracle, bool erase_wrong) : oracle_(oracle), erase_wrong_(erase_wrong) {}
 
   void mapCreated(const std::shared_ptr<core::Map>& map) override {
     std::lock_guard l(mutex_);
@@ -99,6 +100,7 @@ class MatchProbe : public core::SystemEvents {
     const auto f = oracle_.frameOf(kf->frame.timestamp);
     if (!f) return;
     int made = 0, wrong = 0;
+    std::vector<std::shared_ptr<core::MapPoint>> to_erase;
     for (size_t i = 0; i < kf->points.size(); ++i) {
       const auto& p = kf->points[i];
       if (!p || p->bad || p->first_keyframe != kf->id) continue;
@@ -107,6 +109,7 @@ class MatchProbe : public core::SystemEvents {
       ++made;
       const bool joins_two = seesAnotherPoint(*p, *X, kf->frame.keypoints[i].octave);
       wrong += joins_two;
+      if (joins_two && erase_wrong_) to_erase.push_back(p);
       const bool weak = std::any_of(p->observations.begin(), p->observations.end(), [&](const auto& o) {
         return features::isWeakCorner(o.first->frame.keypoints[static_cast<size_t>(o.second)]);
       });
@@ -124,6 +127,7 @@ class MatchProbe : public core::SystemEvents {
     new_points_ += made;
     new_wrong_ += wrong;
     pending_[kf->id] = {made, wrong};
+    for (const auto& p : to_erase) map->erase(*p);
   }
 
   // The keyframe after local BA: its rotation error and the map's scale around it.
@@ -272,6 +276,7 @@ class MatchProbe : public core::SystemEvents {
   }
 
   const SceneOracle& oracle_;
+  const bool erase_wrong_;
   std::mutex mutex_;
   std::optional<Origin> origin_;
   std::map<core::Id, std::pair<int, int>> pending_;
@@ -308,7 +313,7 @@ void evalMatches(const std::string& dataset, const core::SlamSettings& settings,
   auto camera = std::make_shared<camera::PinholeRadTan>(L.width, L.height, L.fx, L.fy, L.cx, L.cy,
                                                         std::vector<double>(L.k.begin(), L.k.end()));
   SceneOracle oracle(model);
-  MatchProbe probe(oracle);
+  MatchProbe probe(oracle, options.oracle);
   core::SlamSettings s = settings;
   s.refine_frames = true;  // the frames' inliers
   core::SlamSystem slam(s, camera, core::SlamSystem::Mode::Sequential);
@@ -318,15 +323,27 @@ void evalMatches(const std::string& dataset, const core::SlamSettings& settings,
   slam.setFrameListener([&](const core::FrameRecord& r, const Eigen::Isometry3d& T_cw, const std::vector<cv::KeyPoint>&,
                             const cv::Mat&) { probe.frame(r, T_cw, slam.findMap(r.map)); });
   const int frames = options.frames > 0 ? std::min(options.frames, o.frames) : o.frames;
-  fmt::print("{}: {} frames{}{}, sequential\n", dataset, frames, options.sharp ? ", sharp (no blur, rolling shutter, tremor or lens error)" : "",
-             options.true_lens ? ", true lens" : "");
+  fmt::print("{}: {} frames{}{}{}, sequential\n", dataset, frames, options.sharp ? ", sharp (no blur, rolling shutter, tremor or lens error)" : "",
+             options.true_lens ? ", true lens" : "", options.oracle ? ", wrong new points erased" : "");
   for (int f = 0; f < frames; ++f) slam.process(model.renderImage(f, rays), model.stamp(f));
   slam.finish();
+  slam.refineFrames();
   probe.summary();
-  if (const auto map = slam.largestMap()) {
+  const auto map = slam.largestMap();
+  if (!map) return;
+  {
     std::lock_guard lock(map->mutex);
     probe.judgeMap(*map);
   }
+  io::Trajectory truth, estimate;
+  for (int f = 0; f < frames; ++f) truth.add(model.stamp(f), model.pose(f));
+  for (const auto& r : slam.frames())
+    if (r.tracked && slam.currentMapId(r.map) == map->id) estimate.add(r.timestamp, slam.poseOf(r));
+  if (estimate.size() < 3) return;
+  const auto ate = eval::computeAte(truth, estimate);
+  fmt::print("largest map of {}: {} of {} frames, ATE RMSE {:.4f} m ({:.2f}% of {:.2f} m)\n", slam.liveMaps().size(),
+             estimate.size(), frames, ate.stats.rmse, 100.0 * ate.stats.rmse / std::max(ate.reference_length, 1e-9),
+             ate.reference_length);
 }
 
 }  // namespace hiveslam::apps

@@ -54,6 +54,8 @@ void addSynthCommand(CLI::App& app) {
                 "rolling shutter, auto exposure, vignetting, JPEG");
   cmd->add_option("--exposure-ms", o->exposure_ms, "With --realistic: exposure time (default 20)");
   cmd->add_option("--readout-ms", o->readout_ms, "With --realistic: rolling shutter readout, 0 for a global shutter (default 25)");
+  cmd->add_option("--denoise", o->denoise, "With --realistic: the camera's denoising, grey levels, 0 for none (default 10)")
+      ->check(CLI::Range(0.0, 255.0));
   cmd->add_option("--tremor-deg", o->tremor_deg, "With --realistic: the hand's tremor, 0 for none (default 0.3)");
   cmd->add_flag("!--exact-lens", o->lens_error, "With --realistic: the images made with the nominal lens of sensor.yaml");
   cmd->add_option("--photo-max-look-alikes", o->photo_max_look_alikes,

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
 
 namespace hiveslam::synth {
 
@@ -14,6 +15,7 @@ Imaging Imaging::realistic() {
   m.auto_exposure = true;
   m.vignetting = 0.3;
   m.shot_noise = 0.06;
+  m.denoise_sigma = 10.0;
   m.jpeg_quality = 85;
   m.focal_error = 0.02;
   m.principal_error_px[0] = 4.0;
@@ -75,6 +77,11 @@ cv::Mat Imaging::develop(const cv::Mat& radiance, double read_noise, uint64_t se
   }
   cv::Mat image;
   signal.convertTo(image, CV_8U);  // rounds and saturates
+  if (denoise_sigma > 0) {
+    cv::Mat smooth;
+    cv::bilateralFilter(image, smooth, 5, denoise_sigma, 2.0);
+    image = smooth;
+  }
   if (jpeg_quality > 0) {
     std::vector<uchar> bytes;
     cv::imencode(".jpg", image, bytes, {cv::IMWRITE_JPEG_QUALITY, jpeg_quality});

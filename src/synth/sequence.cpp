@@ -60,6 +60,7 @@ SequenceModel buildSequence(const SequenceOptions& o) {
     imaging = Imaging::realistic();
     if (o.exposure_ms >= 0) imaging.exposure_s = o.exposure_ms / 1000.0;
     if (o.readout_ms >= 0) imaging.readout_s = o.readout_ms / 1000.0;
+    if (o.denoise >= 0) imaging.denoise_sigma = o.denoise;
     if (!o.lens_error) {
       imaging.focal_error = imaging.hidden_k1 = 0;
       imaging.principal_error_px[0] = imaging.principal_error_px[1] = 0;
@@ -236,6 +237,7 @@ SequenceSummary writeSequence(const SequenceOptions& o, const fs::path& out,
                          {"exposure_ms", o.exposure_ms},
                          {"readout_ms", o.readout_ms},
                          {"tremor_deg", o.tremor_deg},
+                         {"denoise", model.imaging.denoise_sigma},
                          {"lens_error", o.lens_error},
                          {"textures", o.textures.empty() ? "procedural" : o.textures},
                          {"photo_max_look_alikes", photoMaxLookAlikes(o)},
@@ -271,6 +273,7 @@ SequenceOptions readSequenceOptions(const fs::path& dataset) {
     o.readout_ms = info.value("readout_ms", -1.0);
     o.tremor_deg = info.value("tremor_deg", -1.0);
     o.lens_error = info.value("lens_error", true);
+    o.denoise = info.value("denoise", 0.0);  // written before: no denoising
     const auto textures = info.at("textures").get<std::string>();
     if (textures != "procedural") o.textures = textures;
     o.photo_max_look_alikes = info.value("photo_max_look_alikes", 1.0);  // written before: every photo

@@ -29,10 +29,11 @@ struct SequenceOptions {
   // Made to look like a hand-held consumer camera in a lived-in room (synth/imaging.hpp,
   // synth/furnished_room.hpp): a furnished room lit by lamps, a 62-degree lens that differs from
   // the nominal one in sensor.yaml, motion blur of a 20 ms exposure, rolling shutter, auto
-  // exposure, vignetting, shot noise and JPEG. Implies motion_blur; replaces exposure_changes.
+  // exposure, vignetting, shot noise, denoising and JPEG. Implies motion_blur; replaces exposure_changes.
   bool realistic = false;
   // Ablations of the realistic camera (negative: Imaging::realistic()'s value).
   double exposure_ms = -1, readout_ms = -1, tremor_deg = -1;
+  double denoise = -1;           // the camera's denoising, grey levels (Imaging::denoise_sigma)
   bool lens_error = true;        // false: the true lens is the nominal one
   // Photos that repeat themselves more than this are not used as textures (loadPhotos).
   // Negative: realistic renders keep photos up to 0.35, the look-alike share of the most
