@@ -73,6 +73,7 @@ KeyTable slamKeys(core::SlamSettings& s) {
       {"loop_min_sim3_inliers", set(s.loop_min_sim3_inliers)},
       {"loop_min_total_matches", set(s.loop_min_total_matches)},
       {"loop_min_inlier_ratio", set(s.loop_min_inlier_ratio)},
+      {"loop_max_scale_change", set(s.loop_max_scale_change)},
       {"essential_graph_min_weight", set(s.essential_graph_min_weight)},
       {"essential_graph_iterations", set(s.essential_graph_iterations)},
       {"global_ba_iterations", set(s.global_ba_iterations)},
@@ -169,6 +170,8 @@ void applySlamSettings(const std::filesystem::path& file, core::SlamSettings& s)
       o.cell_size < 8 || o.cell_size > 1024)
     throw InputError(file.string() + ": slam.orb settings out of range (features >= 1, levels 1-32, scale_factor 1-4, "
                      "FAST thresholds 1-255, cell_size 8-1024)");
+  if (!(s.loop_max_scale_change >= 1.0))
+    throw InputError(file.string() + ": slam.loop_max_scale_change must be at least 1 (a ratio either way)");
 }
 
 void applyDistributionSettings(const std::filesystem::path& file, distribution::DistributionSettings& s) {

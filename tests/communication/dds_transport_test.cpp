@@ -3,6 +3,7 @@
 #include "communication/dds/dds_transport.hpp"
 
 #include <gtest/gtest.h>
+#include <algorithm>
 #include <unistd.h>
 
 #include <fastdds/dds/domain/DomainParticipant.hpp>
@@ -373,9 +374,18 @@ TEST(DdsTransport, OfTwoProcessesWithOneNodeIdTheLaterIsTheNode) {
     std::lock_guard lock(mutex);
     got.push_back(m.target);
   });
+  const auto heard = [&](uint64_t incarnation) {
+    std::lock_guard lock(mutex);
+    return std::find(incarnations.begin(), incarnations.end(), incarnation) != incarnations.end();
+  };
+  // Node 1 hears the older process before the newer one starts, as at a restart. Until node 1
+  // has heard both, the older one's packets are taken at their word (its announcement may be
+  // still on its way), so the packets below go out only once it has.
   const int dropped_before = droppedAnnouncements();
   older.start(so, [](const PeerInfo&, bool) {});
+  ASSERT_TRUE(testing::eventually([&] { return heard(10); }, std::chrono::seconds(10)));
   newer.start(sn, [](const PeerInfo&, bool) {});
+  ASSERT_TRUE(testing::eventually([&] { return heard(20); }, std::chrono::seconds(10)));
   ASSERT_TRUE(testing::eventually([&] { return droppedAnnouncements() > dropped_before + 1; }, std::chrono::seconds(10)))
       << "the older process's announcements still heard";
   ASSERT_TRUE(testing::eventually([&] { return older.peerReads(Topic::TrKeyframes, 1) && newer.peerReads(Topic::TrKeyframes, 1); },

@@ -158,6 +158,15 @@ TEST(SlamSystem, ClosesTheLoopOfARenderedLoop) {
       << ate_open.stats.rmse << ")";
 }
 
+// A loop whose Sim3 changes the scale by more than loop_max_scale_change either way is
+// refused. At 1, any change of scale at all is: the lap's loop is not closed.
+TEST(SlamSystem, ALoopBeyondTheScaleBoundIsRefused) {
+  SlamSettings settings;
+  settings.loop_max_scale_change = 1.0;
+  const SlamRun run = runSequence("loop", 500, 0, 500, 1, SlamSystem::Mode::Sequential, shippedVocabulary(), settings);
+  EXPECT_EQ(run.loops, 0);
+}
+
 // Tracking is lost in the blank frames and a new map starts after them; recognizing the old
 // map's places welds the two back into one map with every tracked frame in it.
 TEST(SlamSystem, MergesTheMapsAcrossABlankSegment) {

@@ -301,7 +301,8 @@ void LoopCloser::process(const std::shared_ptr<Map>& map_handle, const std::shar
     Verified v;
     {
       std::lock_guard lock(map.mutex);
-      if (kf.bad || place->bad || !verify(kf, *place, v)) {
+      const double max_scale = settings_.loop_max_scale_change;
+      if (kf.bad || place->bad || !verify(kf, *place, v) || v.S12.s > max_scale || v.S12.s < 1.0 / max_scale) {
         ++stats_.rejected_geometry;
         continue;
       }
